@@ -1,0 +1,48 @@
+"""Input checks shared by the package: each raises with the argument, the rule and the value."""
+from __future__ import annotations
+
+import numbers
+
+import numpy as np
+
+
+def positive(name: str, value) -> float:
+    """Return ``value`` as float; raise ValueError unless it is finite and > 0."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not np.isfinite(value) or value <= 0:
+        raise ValueError(f"`{name}` must be a positive finite number, got {value!r}.")
+    return float(value)
+
+
+def nonnegative(name: str, value) -> float:
+    """Return ``value`` as float; raise ValueError unless it is finite and >= 0."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not np.isfinite(value) or value < 0:
+        raise ValueError(f"`{name}` must be a non-negative finite number, got {value!r}.")
+    return float(value)
+
+
+def positive_int(name: str, value) -> int:
+    """Return ``value`` as int; raise ValueError unless it is an integer >= 1."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1:
+        raise ValueError(f"`{name}` must be a positive integer, got {value!r}.")
+    return int(value)
+
+
+def finite_vector(name: str, value, size: int | None = None) -> np.ndarray:
+    """Return ``value`` as a 1-D float array of finite entries (of length ``size`` if given)."""
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"`{name}` must be an array of numbers, got {value!r}.") from None
+    if arr.ndim != 1 or (size is not None and arr.shape[0] != size):
+        want = f"shape ({size},)" if size is not None else "a 1-D array"
+        raise ValueError(f"`{name}` must have {want}, got shape {arr.shape}.")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"`{name}` must be finite (no NaN or inf), got {arr.tolist()}.")
+    return arr
+
+
+def choice(name: str, value, options) -> str:
+    """Return ``value`` if it is one of ``options``; raise ValueError naming them otherwise."""
+    if value not in options:
+        raise ValueError(f"`{name}` must be one of {sorted(options)}, got {value!r}.")
+    return value

@@ -1,0 +1,175 @@
+"""Material law parameters and cross-section properties.
+
+The cross-section lies in the (eta, zeta) plane of the reference
+configuration (chapter Eq. 1): ``eta`` along ``e_y``, ``zeta`` along ``e_z``.
+Following chapter Eq. 42, ``I2`` is the second moment about the local axis 2
+(``int zeta^2 dA``, bending out of the (x, y) plane) and ``I3`` the one about
+axis 3 (``int eta^2 dA``, bending in the (x, y) plane -- the planar case).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from ._validate import positive
+
+__all__ = ["Material", "RectangularSection", "CircularSection", "cowper_shear_factor"]
+
+
+def cowper_shear_factor(nu: float) -> float:
+    """Cowper's shear correction factor of a rectangle, chapter Eq. 112.
+
+    ``k_s = 10 (1 + nu) / (12 + 11 nu)``; 0.8496732026143791 for nu = 0.3.
+    """
+    return 10.0 * (1.0 + nu) / (12.0 + 11.0 * nu)
+
+
+@dataclass(frozen=True)
+class Material:
+    """Linear elastic isotropic material.
+
+    Parameters
+    ----------
+    E : float
+        Young's modulus (> 0).
+    nu : float
+        Poisson's ratio, in [0, 0.5).
+    rho : float
+        Density (> 0).
+    """
+
+    E: float
+    nu: float
+    rho: float
+
+    def __post_init__(self):
+        positive("E", self.E)
+        positive("rho", self.rho)
+        if not (isinstance(self.nu, (int, float)) and 0.0 <= self.nu < 0.5):
+            raise ValueError(f"`nu` must be a number in [0, 0.5), got {self.nu!r}.")
+
+    @property
+    def G(self) -> float:
+        """Shear modulus ``E / (2 (1 + nu))`` (chapter Eq. 112)."""
+        return self.E / (2.0 * (1.0 + self.nu))
+
+
+def _saint_venant_rectangle(h: float, b: float, terms: int = 50) -> float:
+    """Saint-Venant torsion constant of an h x b rectangle (series solution)."""
+    long, short = max(h, b), min(h, b)
+    s = sum(math.tanh(n * math.pi * long / (2 * short)) / n**5 for n in range(1, 2 * terms, 2))
+    return long * short**3 / 3.0 * (1.0 - 192.0 / math.pi**5 * short / long * s)
+
+
+@dataclass(frozen=True)
+class RectangularSection:
+    """Rectangular cross-section, ``h`` along ``eta`` (e_y) and ``b`` along ``zeta`` (e_z).
+
+    Parameters
+    ----------
+    h, b : float
+        Side lengths (> 0); ``b`` defaults to ``h`` (square).
+    shear_factor : float, optional
+        Shear correction factor ``k_s`` used for ``k2`` and ``k3``; None
+        selects Cowper's value of chapter Eq. 112 for the material's ``nu``.
+    torsion_factor : float, optional
+        ``k_t`` such that the torsional rigidity is ``G J k_t`` with
+        ``J = I2 + I3``; None selects the Saint-Venant value (0.8436 for a square).
+    """
+
+    h: float
+    b: float | None = None
+    shear_factor: float | None = None
+    torsion_factor: float | None = None
+
+    def __post_init__(self):
+        positive("h", self.h)
+        if self.b is None:
+            object.__setattr__(self, "b", float(self.h))
+        positive("b", self.b)
+        if self.shear_factor is not None:
+            positive("shear_factor", self.shear_factor)
+        if self.torsion_factor is not None:
+            positive("torsion_factor", self.torsion_factor)
+
+    @property
+    def A(self) -> float:
+        """Area."""
+        return self.h * self.b
+
+    @property
+    def I2(self) -> float:
+        """``int zeta^2 dA = h b^3 / 12`` (bending out of the x-y plane)."""
+        return self.h * self.b**3 / 12.0
+
+    @property
+    def I3(self) -> float:
+        """``int eta^2 dA = b h^3 / 12`` (bending in the x-y plane)."""
+        return self.b * self.h**3 / 12.0
+
+    @property
+    def I4(self) -> float:
+        """``int eta^4 dA = b h^5 / 80`` (enters the SVK bending moment, chapter Eq. 85)."""
+        return self.b * self.h**5 / 80.0
+
+    @property
+    def J(self) -> float:
+        """Polar moment ``I2 + I3``."""
+        return self.I2 + self.I3
+
+    def k_s(self, material: Material) -> float:
+        """Shear correction factor (Cowper's by default)."""
+        return self.shear_factor if self.shear_factor is not None else cowper_shear_factor(material.nu)
+
+    @property
+    def k_t(self) -> float:
+        """Torsion factor: Saint-Venant torsion constant over ``J``."""
+        if self.torsion_factor is not None:
+            return self.torsion_factor
+        return _saint_venant_rectangle(self.h, self.b) / self.J
+
+
+@dataclass(frozen=True)
+class CircularSection:
+    """Solid circular cross-section of diameter ``d``.
+
+    ``k_t = 1`` (the polar moment is the torsion constant); the default shear
+    factor is ``6 (1 + nu) / (7 + 6 nu)`` (Cowper, solid circle).
+    """
+
+    d: float
+    shear_factor: float | None = None
+    torsion_factor: float | None = None
+
+    def __post_init__(self):
+        positive("d", self.d)
+
+    @property
+    def A(self) -> float:
+        return math.pi * self.d**2 / 4.0
+
+    @property
+    def I2(self) -> float:
+        return math.pi * self.d**4 / 64.0
+
+    @property
+    def I3(self) -> float:
+        return self.I2
+
+    @property
+    def I4(self) -> float:
+        """``int eta^4 dA = pi d^6 / 512``."""
+        return math.pi * self.d**6 / 512.0
+
+    @property
+    def J(self) -> float:
+        return self.I2 + self.I3
+
+    def k_s(self, material: Material) -> float:
+        if self.shear_factor is not None:
+            return self.shear_factor
+        return 6.0 * (1.0 + material.nu) / (7.0 + 6.0 * material.nu)
+
+    @property
+    def k_t(self) -> float:
+        return 1.0 if self.torsion_factor is None else self.torsion_factor

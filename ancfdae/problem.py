@@ -1,0 +1,136 @@
+"""The contract between models and integrators (design.md Sect. 3).
+
+A *Model* is the semi-discrete equation of motion in residual form, with the
+boundary conditions already applied (fixed coordinates eliminated)::
+
+    r(t, q, v, a) = M(q) a + f_int(q, v) - f_ext(t, q, v) = 0
+
+Integrators -- ours and a user's own -- need nothing but this protocol.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+import scipy.sparse as sp
+
+__all__ = ["Model", "JacobianBlocks", "Energy"]
+
+
+@dataclass(frozen=True)
+class JacobianBlocks:
+    """Partial derivatives of the residual ``r(t, q, v, a)``.
+
+    Attributes
+    ----------
+    K : scipy.sparse matrix
+        ``dr/dq`` (tangent stiffness, including load and inertia terms that
+        depend on ``q``).
+    D : scipy.sparse matrix
+        ``dr/dv`` (damping and velocity-dependent inertia).
+    M : scipy.sparse matrix
+        ``dr/da`` (the mass matrix).
+    same_pattern : bool
+        True when ``K``, ``D`` and ``M`` are CSR matrices sharing one
+        sparsity structure (identical ``indptr`` and ``indices``); then an
+        iteration matrix ``alpha*K + beta*D + gamma*M`` can be formed by
+        combining the ``data`` arrays alone (see :meth:`combine`).
+    """
+
+    K: sp.spmatrix
+    D: sp.spmatrix
+    M: sp.spmatrix
+    same_pattern: bool = False
+
+    def combine(self, alpha: float, beta: float, gamma: float) -> sp.csr_matrix:
+        """Return ``alpha*K + beta*D + gamma*M`` as a CSR matrix.
+
+        Uses the shared pattern when available (no sparse addition, no
+        pattern reallocation), otherwise falls back to sparse arithmetic.
+        """
+        if self.same_pattern:
+            data = alpha * self.K.data + beta * self.D.data + gamma * self.M.data
+            return sp.csr_matrix((data, self.K.indices, self.K.indptr), shape=self.K.shape)
+        return sp.csr_matrix(alpha * self.K + beta * self.D + gamma * self.M)
+
+
+@dataclass(frozen=True)
+class Energy:
+    """Mechanical energies of a state.
+
+    Attributes
+    ----------
+    kinetic : float
+        ``T = 1/2 v^T M(q) v``.
+    strain : float
+        Strain energy ``U(q)`` of the elastic forces.
+    potential : float
+        Potential ``V(t, q)`` of the conservative loads (e.g. gravity).
+    """
+
+    kinetic: float
+    strain: float
+    potential: float = 0.0
+
+    @property
+    def total(self) -> float:
+        """``T + U + V``."""
+        return self.kinetic + self.strain + self.potential
+
+
+@runtime_checkable
+class Model(Protocol):
+    """Semi-discrete equations of motion ``M(q) a + f_int(q, v) - f_ext(t, q, v) = 0``.
+
+    Attributes
+    ----------
+    n_dof : int
+        Number of (free) coordinates.
+    mass_is_constant : bool
+        True when ``M`` does not depend on ``q`` (every ANCF element except
+        BE3D, whose cross-section rotary inertia depends on the slopes).
+
+    Notes
+    -----
+    ``jacobian`` must be exact (analytic or automatic differentiation),
+    never finite differences at run time. Models may also provide
+    ``accept_step(t, q, v) -> (q, v)``, a hook that integrators and the
+    static solver call after every accepted step (BE3D's director update
+    uses it); it must leave the physical configuration unchanged.
+    """
+
+    n_dof: int
+    mass_is_constant: bool
+
+    def initial_state(self) -> tuple[np.ndarray, np.ndarray]:
+        """Initial coordinates and velocities ``(q0, v0)``."""
+        ...
+
+    def mass(self, q: np.ndarray) -> sp.spmatrix:
+        """Mass matrix ``M(q)``."""
+        ...
+
+    def residual(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        """Residual ``r(t, q, v, a)``, shape ``(n_dof,)``."""
+        ...
+
+    def jacobian(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> JacobianBlocks:
+        """Exact ``dr/dq``, ``dr/dv``, ``dr/da``."""
+        ...
+
+    def energy(self, t: float, q: np.ndarray, v: np.ndarray) -> Energy:
+        """Kinetic, strain and conservative-load potential energy."""
+        ...
+
+    def external_power(self, t: float, q: np.ndarray, v: np.ndarray) -> float:
+        """Power of the non-conservative loads, ``f_nc(t, q, v) . v``."""
+        ...
+
+
+def accept_step(model, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Call the model's optional ``accept_step`` hook; identity when absent."""
+    hook = getattr(model, "accept_step", None)
+    if hook is None:
+        return q, v
+    return hook(t, q, v)
