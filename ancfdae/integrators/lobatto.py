@@ -234,6 +234,8 @@ class LobattoIIIA(FixedStepIntegrator):
             X = x.reshape(n, m)
             Q, V_ = self._stages(X, t, h)
             blocks = [self._jacobian(ts[i], Q[:, i], V_[:, i], X[:, i]) for i in range(m)]
+            for i, blk in enumerate(blocks):
+                self._set_floor(blk, Q[:, i])
             return self._matrix(blocks, h)
 
         out = self.newton.solve(residual, jacobian, self._guess(h).ravel())
