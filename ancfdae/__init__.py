@@ -7,6 +7,9 @@ from .loads import DistributedLoad, Gravity, PointForce, PointMoment, constant, 
 from .materials import CircularSection, Material, RectangularSection, cowper_shear_factor
 from .problem import Energy, JacobianBlocks, Model
 from .static import StaticResult, solve_static
+from .simulate import METHODS, simulate
+from .result import Result
+from .monitors import EnergyMonitor, PointSensor, Probe
 
 __version__ = "0.1.0"
 
@@ -15,4 +18,5 @@ __all__ = [
     "PointForce", "PointMoment", "Gravity", "DistributedLoad", "constant", "ramp", "pulse", "hat",
     "Model", "JacobianBlocks", "Energy",
     "solve_static", "StaticResult",
+    "simulate", "METHODS", "Result", "EnergyMonitor", "PointSensor", "Probe",
 ]

@@ -1,0 +1,250 @@
+"""Lobatto IIIA collocation, fixed step (the chapter's integrator, Sect. 5.2).
+
+The chapter integrates with "a two staged trapezoidal rule (Lobatto), which
+means three integration points per time step and a fourth-order global
+convergence", i.e. Lobatto IIIA with s = 3 stages, with a modified Newton
+method on each step. s = 2 is the trapezoidal rule (order 2).
+
+The s-stage method is applied to ``q' = v, v' = a`` with ``r(t, q, v, a) = 0``
+(design.md Sect. 3) and the stage accelerations ``A_i`` as unknowns::
+
+    V_i = v_n + h sum_j a_ij A_j
+    Q_i = q_n + c_i h v_n + h^2 sum_j (a^2)_ij A_j
+    r(t_n + c_i h, Q_i, V_i, A_i) = 0,   i = 2..s
+
+Lobatto IIIA has an explicit first stage (first row of ``a`` zero: ``A_1`` is
+the acceleration at ``t_n``, known from the previous step or the consistent
+initial acceleration) and is stiffly accurate (last row of ``a`` = ``b``: the
+new state is the last stage). The Newton matrix for the unknowns
+``X = [A_2 .. A_s]``, stored interleaved (``X[p*(s-1) + i]``) so that it keeps
+the band structure of the model's matrices, has the blocks::
+
+    dr_i / dA_k = delta_ik M_i + h a_ik D_i + h^2 (a^2)_ik K_i
+
+with ``K_i, D_i, M_i`` the exact Jacobian blocks at stage ``i``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from ancfdae import _validate as V
+from ancfdae.integrators._base import FixedStepIntegrator
+
+__all__ = ["ButcherTableau", "LOBATTO_IIIA_2", "LOBATTO_IIIA_3", "LobattoIIIA"]
+
+
+@dataclass(frozen=True)
+class ButcherTableau:
+    """A Runge-Kutta tableau that checks itself (imitates diffrax's ``ButcherTableau``).
+
+    Checks: square ``a`` of ``s`` stages, ``b`` and ``c`` of length ``s``,
+    finite entries, the row-sum condition ``c_i = sum_j a_ij``, and the
+    quadrature conditions ``sum_i b_i c_i^(k-1) = 1/k`` for ``k = 1..order``
+    (necessary for the declared order).
+    """
+
+    a: np.ndarray
+    b: np.ndarray
+    c: np.ndarray
+    order: int
+    name: str = ""
+
+    def __post_init__(self):
+        a = np.array(self.a, dtype=float)
+        b = np.array(self.b, dtype=float)
+        c = np.array(self.c, dtype=float)
+        if a.ndim != 2 or a.shape[0] != a.shape[1]:
+            raise ValueError(f"tableau `a` must be square, got shape {a.shape}.")
+        s = a.shape[0]
+        if b.shape != (s,) or c.shape != (s,):
+            raise ValueError(f"tableau `b` and `c` must have shape ({s},), got {b.shape} and {c.shape}.")
+        if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b)) and np.all(np.isfinite(c))):
+            raise ValueError("tableau entries must be finite.")
+        if not np.allclose(a.sum(axis=1), c, rtol=0, atol=1e-14):
+            raise ValueError(f"tableau violates c_i = sum_j a_ij: c = {c}, row sums = {a.sum(axis=1)}.")
+        V.positive_int("order", self.order)
+        for k in range(1, self.order + 1):
+            if abs(b @ c ** (k - 1) - 1.0 / k) > 1e-14:
+                raise ValueError(f"tableau {self.name!r} violates the order-{self.order} quadrature condition "
+                                 f"sum b c^{k - 1} = 1/{k} (got {b @ c ** (k - 1)!r}).")
+        for name, arr in (("a", a), ("b", b), ("c", c)):
+            arr.setflags(write=False)
+            object.__setattr__(self, name, arr)
+
+    @property
+    def stages(self) -> int:
+        return self.a.shape[0]
+
+    @property
+    def explicit_first_stage(self) -> bool:
+        return bool(np.all(self.a[0] == 0.0))
+
+    @property
+    def stiffly_accurate(self) -> bool:
+        return bool(np.array_equal(self.a[-1], self.b))
+
+
+LOBATTO_IIIA_2 = ButcherTableau(a=[[0, 0], [0.5, 0.5]], b=[0.5, 0.5], c=[0, 1], order=2,
+                                name="Lobatto IIIA (2 stages, trapezoidal rule)")
+LOBATTO_IIIA_3 = ButcherTableau(a=[[0, 0, 0], [5 / 24, 1 / 3, -1 / 24], [1 / 6, 2 / 3, 1 / 6]],
+                                b=[1 / 6, 2 / 3, 1 / 6], c=[0, 0.5, 1], order=4,
+                                name="Lobatto IIIA (3 stages)")
+_TABLEAUX = {2: LOBATTO_IIIA_2, 3: LOBATTO_IIIA_3}
+
+
+def _lagrange_weights(nodes, points):
+    """``W[i, j] = l_j(points[i])`` for the Lagrange basis on ``nodes``."""
+    nodes, points = np.asarray(nodes, float), np.asarray(points, float)
+    W = np.ones((points.size, nodes.size))
+    for j, xj in enumerate(nodes):
+        for k, xk in enumerate(nodes):
+            if k != j:
+                W[:, j] *= (points - xk) / (xj - xk)
+    return W
+
+
+class LobattoIIIA(FixedStepIntegrator):
+    """Lobatto IIIA, fixed step, (modified) Newton on the stage accelerations.
+
+    Parameters
+    ----------
+    model : Model
+    h : float
+        Step size.
+    stages : {2, 3} or ButcherTableau
+        3 = the chapter's order-4 method (default); 2 = trapezoidal rule.
+        A custom tableau must have an explicit first stage and be stiffly
+        accurate.
+    newton : NewtonOptions or dict, optional
+        Default: modified Newton, relative tolerance 1e-8 (chapter Sect. 5.2).
+    predictor : {"extrapolate", "constant"}
+        Initial guess of the stage accelerations: the previous step's
+        collocation polynomial extrapolated, or ``a_n`` in every stage.
+    """
+
+    def __init__(self, model, h, stages=3, *, newton=None, predictor="extrapolate"):
+        super().__init__(model, h, newton=newton)
+        if isinstance(stages, ButcherTableau):
+            tab = stages
+        elif not isinstance(stages, bool) and stages in _TABLEAUX:
+            tab = _TABLEAUX[stages]
+        else:
+            raise ValueError(f"`stages` must be 2, 3 or a ButcherTableau, got {stages!r}.")
+        if not (tab.explicit_first_stage and tab.stiffly_accurate):
+            raise ValueError(f"`stages`: tableau {tab.name!r} must have an explicit first stage and be stiffly "
+                             "accurate (Lobatto IIIA type).")
+        self.tableau = tab
+        self.predictor = V.choice("predictor", predictor, ("extrapolate", "constant"))
+        self.name = f"lobatto{tab.stages}"
+        self.order = tab.order
+        s = tab.stages
+        self._m = s - 1
+        a2 = tab.a @ tab.a
+        self._a_first, self._a_rest = tab.a[1:, 0].copy(), tab.a[1:, 1:].copy()
+        self._a2_first, self._a2_rest = a2[1:, 0].copy(), a2[1:, 1:].copy()
+        self._c = tab.c[1:].copy()
+        self._perm = None
+
+    def options(self):
+        o = super().options()
+        o.update(stages=self.tableau.stages, predictor=self.predictor)
+        return o
+
+    def _init_impl(self):
+        self._prev = None  # (h, stage accelerations (n, s)) of the last step
+
+    # -- stage states ------------------------------------------------------------------------
+    def _stages(self, X, t, h):
+        """Stage coordinates and velocities (n, m) for stage accelerations ``X`` (n, m)."""
+        V_ = self.v[:, None] + h * (self.a[:, None] * self._a_first + X @ self._a_rest.T)
+        Q = self.q[:, None] + h * self._c * self.v[:, None] + h * h * (self.a[:, None] * self._a2_first
+                                                                        + X @ self._a2_rest.T)
+        return Q, V_
+
+    def _guess(self, h):
+        m = self._m
+        if self.predictor == "constant" or self._prev is None:
+            return np.repeat(self.a[:, None], m, axis=1)
+        h_prev, A_prev = self._prev
+        W = _lagrange_weights(self.tableau.c, 1.0 + self._c * (h / h_prev))
+        return A_prev @ W.T
+
+    # -- iteration matrix --------------------------------------------------------------------
+    def _pattern(self, K):
+        """Index map from the per-entry block values (nnz, m, m) to the interleaved CSR data."""
+        m, n = self._m, self.n_dof
+        indptr, indices = K.indptr, K.indices
+        nnz = indices.size
+        row = np.repeat(np.arange(n), np.diff(indptr))
+        e, i, k = (g.ravel() for g in np.meshgrid(np.arange(nnz), np.arange(m), np.arange(m), indexing="ij"))
+        order = np.lexsort((k, e, i, row[e]))
+        big_indices = (indices[e] * m + k)[order]
+        counts = np.repeat(np.diff(indptr) * m, m)
+        big_indptr = np.r_[0, np.cumsum(counts)]
+        self._perm = (indptr.copy(), indices.copy(), order, big_indices, big_indptr)
+
+    def _matrix(self, blocks, h):
+        m, n = self._m, self.n_dof
+        if m == 1:
+            J = blocks[0]
+            return J.combine(h * h * self._a2_rest[0, 0], h * self._a_rest[0, 0], 1.0)
+        cK, cD = h * h * self._a2_rest, h * self._a_rest
+        if all(b.same_pattern for b in blocks):
+            K0 = blocks[0].K
+            if (self._perm is None or self._perm[0].shape != K0.indptr.shape
+                    or self._perm[1].shape != K0.indices.shape
+                    or not np.array_equal(self._perm[0], K0.indptr)
+                    or not np.array_equal(self._perm[1], K0.indices)):
+                self._pattern(K0)
+            _, _, order, big_indices, big_indptr = self._perm
+            if all(np.array_equal(b.K.indices, K0.indices) and np.array_equal(b.K.indptr, K0.indptr)
+                   for b in blocks[1:]):
+                vals = np.empty((K0.indices.size, m, m))
+                for i, b in enumerate(blocks):
+                    vals[:, i, :] = b.K.data[:, None] * cK[i] + b.D.data[:, None] * cD[i]
+                    vals[:, i, i] += b.M.data
+                return sp.csr_matrix((vals.ravel()[order], big_indices, big_indptr), shape=(n * m, n * m))
+        # generic: entry ((p, i), (q, k)) of block (i, k) -> kron(B_ik, E_ik)
+        out = None
+        for i, b in enumerate(blocks):
+            for k in range(m):
+                B = cK[i, k] * b.K + cD[i, k] * b.D + (b.M if i == k else 0 * b.M)
+                E = sp.csr_matrix(([1.0], ([i], [k])), shape=(m, m))
+                term = sp.kron(B, E, format="csr")
+                out = term if out is None else out + term
+        return out.tocsr()
+
+    # -- one step ----------------------------------------------------------------------------
+    def _step_impl(self, t, h):
+        m, n = self._m, self.n_dof
+        ts = t + self._c * h
+
+        def residual(x):
+            X = x.reshape(n, m)
+            Q, V_ = self._stages(X, t, h)
+            R = np.empty((n, m))
+            for i in range(m):
+                R[:, i] = self._residual(ts[i], Q[:, i], V_[:, i], X[:, i])
+            return R.ravel()
+
+        def jacobian(x):
+            X = x.reshape(n, m)
+            Q, V_ = self._stages(X, t, h)
+            blocks = [self._jacobian(ts[i], Q[:, i], V_[:, i], X[:, i]) for i in range(m)]
+            for i, blk in enumerate(blocks):
+                self._set_floor(blk, Q[:, i])
+            return self._matrix(blocks, h)
+
+        out = self.newton.solve(residual, jacobian, self._guess(h).ravel())
+        if not out.converged:
+            return False, f"Newton: {out.message}"
+        X = out.x.reshape(n, m)
+        Q, V_ = self._stages(X, t, h)
+        A_all = np.column_stack([self.a, X])
+        self._prev = (h, A_all)
+        nodes = (np.r_[t, ts], np.column_stack([self.q, Q]).T, np.column_stack([self.v, V_]).T,
+                 h * self.tableau.b)
+        return True, (Q[:, -1].copy(), V_[:, -1].copy(), X[:, -1].copy(), nodes)

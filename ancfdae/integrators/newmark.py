@@ -1,0 +1,153 @@
+"""Newmark family: Newmark (beta, gamma), HHT-alpha, generalized-alpha.
+
+All three are one scheme, the generalized-alpha method of Chung and Hulbert
+(J. Appl. Mech. 60:371, 1993), written on the residual of the Model contract
+(design.md Sect. 3) with the unknown ``a_{n+1}``::
+
+    q_{n+1} = q_n + h v_n + h^2 ((1/2 - beta) a_n + beta a_{n+1})
+    v_{n+1} = v_n + h ((1 - gamma) a_n + gamma a_{n+1})
+    r(t_{n+1-af}, q_{n+1-af}, v_{n+1-af}, a_{n+1-am}) = 0,   x_{n+1-al} = (1-al) x_{n+1} + al x_n
+
+* Newmark: ``am = af = 0`` (default ``beta = 1/4, gamma = 1/2``: the
+  trapezoidal rule, energy-conserving on linear problems, order 2).
+* HHT-alpha (Hilber, Hughes, Taylor 1977): ``am = 0, af = alpha`` with
+  ``alpha`` in [0, 1/3] (Hilber's ``-alpha``), ``gamma = 1/2 + alpha``,
+  ``beta = (1 + alpha)^2 / 4``.
+* generalized-alpha: from the spectral radius at infinite frequency
+  ``rho_inf`` in [0, 1]: ``am = (2 rho - 1)/(rho + 1)``, ``af = rho/(rho + 1)``,
+  ``gamma = 1/2 - am + af``, ``beta = (1 - am + af)^2 / 4`` (order 2,
+  unconditionally stable, high-frequency dissipation controlled by rho_inf).
+
+The residual is evaluated at the weighted state (not as weighted forces),
+which keeps the scheme on the contract alone, with one residual call per
+Newton iteration; for nonlinear problems it is the state-averaged variant of
+these methods (second order as well). ``a`` reported for ``am, af != 0`` is
+the algorithmic acceleration. Newton matrix:
+``(1 - af)(h^2 beta K + h gamma D) + (1 - am) M``.
+"""
+from __future__ import annotations
+
+import numbers
+
+from ancfdae.integrators._base import FixedStepIntegrator
+
+__all__ = ["Newmark", "HHTAlpha", "GeneralizedAlpha"]
+
+
+def _param(name, value, low, high):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not (low <= value <= high):
+        raise ValueError(f"`{name}` must be a real number in [{low}, {high}], got {value!r}.")
+    return float(value)
+
+
+class _AlphaFamily(FixedStepIntegrator):
+    """The shared generalized-alpha step (parameters validated by the subclasses)."""
+
+    order = 2
+
+    def __init__(self, model, h, beta, gamma, alpha_m, alpha_f, newton):
+        super().__init__(model, h, newton=newton)
+        self.beta, self.gamma, self.alpha_m, self.alpha_f = beta, gamma, alpha_m, alpha_f
+
+    def options(self):
+        o = super().options()
+        o.update(beta=self.beta, gamma=self.gamma, alpha_m=self.alpha_m, alpha_f=self.alpha_f)
+        return o
+
+    def _step_impl(self, t, h):
+        am, af, b, g = self.alpha_m, self.alpha_f, self.beta, self.gamma
+        ta = t + (1.0 - af) * h
+        # q_{n+1}, v_{n+1} and the weighted state are affine in x = a_{n+1}: precompute the
+        # constant parts once per step (each NumPy call costs ~1 us at these sizes).
+        q_pred = self.q + h * self.v + (h * h * (0.5 - b)) * self.a
+        v_pred = self.v + (h * (1.0 - g)) * self.a
+        cq, cv = h * h * b, h * g
+        qa0 = self.q + (1 - af) * (q_pred - self.q)
+        va0 = self.v + (1 - af) * (v_pred - self.v)
+        aa0 = am * self.a
+        cqa, cva, caa = (1 - af) * cq, (1 - af) * cv, 1.0 - am
+
+        def residual(x):
+            return self._residual(ta, qa0 + cqa * x, va0 + cva * x, aa0 + caa * x)
+
+        def jacobian(x):
+            qa = qa0 + cqa * x
+            J = self._jacobian(ta, qa, va0 + cva * x, aa0 + caa * x)
+            self._set_floor(J, qa)
+            return J.combine(cqa, cva, caa)
+
+        out = self.newton.solve(residual, jacobian, self.a)
+        if not out.converged:
+            return False, f"Newton: {out.message}"
+        x = out.x
+        return True, (q_pred + cq * x, v_pred + cv * x, x, None)
+
+
+class Newmark(_AlphaFamily):
+    """Newmark's method (``am = af = 0``).
+
+    Parameters
+    ----------
+    model : Model
+    h : float
+    beta : float
+        In [0, 1/2]; default 1/4 (average acceleration / trapezoidal rule).
+    gamma : float
+        In [0, 1]; default 1/2 (no numerical dissipation; order 2 only for
+        gamma = 1/2, order 1 otherwise).
+    newton : NewtonOptions or dict, optional
+    """
+
+    name = "newmark"
+
+    def __init__(self, model, h, beta=0.25, gamma=0.5, *, newton=None):
+        super().__init__(model, h, _param("beta", beta, 0.0, 0.5), _param("gamma", gamma, 0.0, 1.0),
+                         0.0, 0.0, newton)
+        self.order = 2 if self.gamma == 0.5 else 1
+
+
+class HHTAlpha(_AlphaFamily):
+    """Hilber-Hughes-Taylor alpha method.
+
+    Parameters
+    ----------
+    alpha : float
+        In [0, 1/3] (Hilber's parameter with the sign flipped); 0 is the
+        trapezoidal rule, larger values damp high frequencies more.
+    """
+
+    name = "hht"
+
+    def __init__(self, model, h, alpha=0.05, *, newton=None):
+        alpha = _param("alpha", alpha, 0.0, 1.0 / 3.0)
+        super().__init__(model, h, (1 + alpha) ** 2 / 4, 0.5 + alpha, 0.0, alpha, newton)
+        self.alpha = alpha
+
+    def options(self):
+        o = super().options()
+        o["alpha"] = self.alpha
+        return o
+
+
+class GeneralizedAlpha(_AlphaFamily):
+    """Generalized-alpha method of Chung and Hulbert.
+
+    Parameters
+    ----------
+    rho_inf : float
+        Spectral radius at infinite frequency, in [0, 1]; 1 = no dissipation
+        (the trapezoidal rule), 0 = asymptotic annihilation.
+    """
+
+    name = "generalized-alpha"
+
+    def __init__(self, model, h, rho_inf=0.8, *, newton=None):
+        rho = _param("rho_inf", rho_inf, 0.0, 1.0)
+        am, af = (2 * rho - 1) / (rho + 1), rho / (rho + 1)
+        super().__init__(model, h, (1 - am + af) ** 2 / 4, 0.5 - am + af, am, af, newton)
+        self.rho_inf = rho
+
+    def options(self):
+        o = super().options()
+        o["rho_inf"] = self.rho_inf
+        return o

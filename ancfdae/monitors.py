@@ -1,0 +1,222 @@
+"""Monitors: energy balance and point sensors, logged at the output times (design.md Sect. 6).
+
+Every integrator drives a monitor through four calls:
+
+``start(model, t0, q0, v0, a0)``
+    once, before the first step;
+``advance(t, q, v, a, nodes=None)``
+    after every accepted step (on IDA: after every output interval), with an
+    optional quadrature of the step, ``nodes = (ts, Q, V, w)`` (times, stage
+    coordinates and velocities as rows, weights that sum to the step size),
+    for integrals over the step;
+``sample(t, q, v, a)``
+    at every output time (``t`` lies in the last advanced step);
+``log()``
+    the arrays (one entry per output time) and scalars stored in
+    ``Result.monitors[name]``.
+
+``stop_reason()`` returns a string when the monitor asks the run to end.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ancfdae import _validate as V
+
+__all__ = ["Monitor", "EnergyMonitor", "PointSensor", "Probe"]
+
+
+class Monitor:
+    """Base class: no-op hooks; subclasses set ``name`` and override what they need."""
+
+    name = "monitor"
+
+    def start(self, model, t, q, v, a) -> None:  # noqa: D102
+        self.model = model
+
+    def advance(self, t, q, v, a, nodes=None) -> None:  # noqa: D102
+        pass
+
+    def sample(self, t, q, v, a) -> None:  # noqa: D102
+        pass
+
+    def log(self) -> dict:  # noqa: D102
+        return {}
+
+    def stop_reason(self) -> str | None:  # noqa: D102
+        return None
+
+
+class EnergyMonitor(Monitor):
+    """Energy balance ``E(t) = T + U + V - W_ext`` (design.md Sect. 6).
+
+    ``T, U, V`` come from ``model.energy`` (kinetic, strain, potential of the
+    conservative loads). ``W_ext(t) = int_t0^t P_ext dt`` is the work of the
+    non-conservative loads, integrated from ``model.external_power`` over the
+    integrator's steps: with the step's own quadrature when the integrator
+    supplies one (Lobatto IIIA: its Lobatto nodes and weights, exact for
+    polynomials of degree 2s-3, error O(h^(2s-2)) on smooth power histories),
+    otherwise with the trapezoidal rule over the step grid (error O(h^2); on
+    IDA the grid is the output grid). Output times that fall inside a step
+    interpolate ``W_ext`` linearly. For the exact solution ``E`` is constant;
+    ``drift = E(t) - E(t0)``.
+
+    Parameters
+    ----------
+    name : str
+        Key in ``Result.monitors``.
+    blowup : float
+        Relative drift above which the run is flagged as blown up:
+        ``drift > blowup * scale`` with ``scale`` the largest
+        ``|T| + |U| + |V| + |W_ext|`` logged so far; non-finite energies
+        always count.
+    stop_on_blowup : bool
+        Ask the integrator to end the run (status "failed") at a blow-up.
+
+    Notes
+    -----
+    Internal damping is not a load: a damped model loses ``E``.
+    """
+
+    def __init__(self, name: str = "energy", blowup: float = 0.1, stop_on_blowup: bool = False):
+        self.name = str(name)
+        self.blowup = V.positive("blowup", blowup)
+        if not isinstance(stop_on_blowup, bool):
+            raise ValueError(f"`stop_on_blowup` must be True or False, got {stop_on_blowup!r}.")
+        self.stop_on_blowup = stop_on_blowup
+
+    def start(self, model, t, q, v, a):
+        for attr in ("energy", "external_power"):
+            if not callable(getattr(model, attr, None)):
+                raise TypeError(f"EnergyMonitor needs `model.{attr}(t, q, v)`; "
+                                f"{type(model).__name__} has none.")
+        self.model = model
+        self._rows: list[tuple] = []
+        self._work = 0.0
+        self._t_prev = self._t_cur = float(t)
+        self._w_prev = self._w_cur = 0.0
+        self._p_cur = float(model.external_power(t, q, v))
+        self._scale = 0.0
+        self._e0 = None
+        self._blow = None
+
+    def advance(self, t, q, v, a, nodes=None):
+        p_end = float(self.model.external_power(t, q, v))
+        if nodes is None:
+            dw = 0.5 * (t - self._t_cur) * (self._p_cur + p_end)
+        else:
+            ts, Q, Vs, w = nodes
+            dw = sum(wj * float(self.model.external_power(tj, Qj, Vj)) for tj, Qj, Vj, wj in zip(ts, Q, Vs, w))
+        self._t_prev, self._w_prev = self._t_cur, self._w_cur
+        self._t_cur, self._w_cur, self._p_cur = float(t), self._w_cur + dw, p_end
+
+    def _work_at(self, t):
+        if t >= self._t_cur or self._t_cur == self._t_prev:
+            return self._w_cur
+        theta = (t - self._t_prev) / (self._t_cur - self._t_prev)
+        return self._w_prev + theta * (self._w_cur - self._w_prev)
+
+    def sample(self, t, q, v, a):
+        e = self.model.energy(t, q, v)
+        w = self._work_at(float(t))
+        total = e.kinetic + e.strain + e.potential
+        balance = total - w
+        if self._e0 is None:
+            self._e0 = balance
+        self._scale = max(self._scale, abs(e.kinetic) + abs(e.strain) + abs(e.potential) + abs(w))
+        drift = balance - self._e0
+        if self._blow is None and (not np.isfinite(balance) or drift > self.blowup * self._scale):
+            self._blow = float(t)
+        self._rows.append((e.kinetic, e.strain, e.potential, w, total, balance, drift))
+
+    def stop_reason(self):
+        if self.stop_on_blowup and self._blow is not None:
+            return f"energy blow-up detected at t = {self._blow:.6g} by monitor {self.name!r}"
+        return None
+
+    def log(self):
+        rows = np.array(self._rows, dtype=float).reshape(-1, 7)
+        keys = ("kinetic", "strain", "potential", "work", "total", "balance", "drift")
+        out = {k: rows[:, i].copy() for i, k in enumerate(keys)}
+        finite = out["drift"][np.isfinite(out["drift"])]
+        max_drift = float(np.max(np.abs(finite))) if finite.size else float("nan")
+        out.update(max_abs_drift=max_drift, scale=float(self._scale),
+                   relative_drift=max_drift / self._scale if self._scale > 0 else float("nan"),
+                   blow_up=self._blow is not None, t_blow_up=self._blow)
+        return out
+
+
+class PointSensor(Monitor):
+    """Position and velocity of a point of the beam axis at the output times.
+
+    Parameters
+    ----------
+    s : float, optional
+        Reference arc length of the point; uses ``model.position(q, s)``.
+        The velocity is then ``position(q + v, s) - position(q, s)``, exact
+        because ANCF positions are affine in the coordinates (``r = S(s) e``
+        with the fixed coordinates filled in, chapter Eq. 54).
+    function : callable, optional
+        ``function(q) -> position`` for models without ``position``; its
+        velocity is logged only when ``velocity_function(q, v)`` is given.
+    name : str, optional
+        Key in ``Result.monitors`` (default ``"point@s"`` or ``"point"``).
+    velocity_function : callable, optional
+    """
+
+    def __init__(self, s=None, *, function=None, name=None, velocity_function=None):
+        if (s is None) == (function is None):
+            raise ValueError("PointSensor needs exactly one of `s` (arc length) or `function`, "
+                             f"got s={s!r}, function={function!r}.")
+        if s is not None:
+            s = V.nonnegative("s", s)
+        if function is not None and not callable(function):
+            raise ValueError(f"`function` must be callable, got {function!r}.")
+        if velocity_function is not None and not callable(velocity_function):
+            raise ValueError(f"`velocity_function` must be callable, got {velocity_function!r}.")
+        self.s, self.function, self.velocity_function = s, function, velocity_function
+        self.name = name if name is not None else (f"point@{s:g}" if s is not None else "point")
+
+    def start(self, model, t, q, v, a):
+        if self.s is not None and not callable(getattr(model, "position", None)):
+            raise TypeError(f"PointSensor(s=...) needs `model.position(q, s)`; {type(model).__name__} has "
+                            "none: pass `function=` instead.")
+        self.model = model
+        self._pos, self._vel = [], []
+
+    def sample(self, t, q, v, a):
+        if self.s is not None:
+            p = np.asarray(self.model.position(q, self.s), dtype=float)
+            self._pos.append(p)
+            self._vel.append(np.asarray(self.model.position(q + v, self.s), dtype=float) - p)
+        else:
+            self._pos.append(np.atleast_1d(np.asarray(self.function(q), dtype=float)))
+            if self.velocity_function is not None:
+                self._vel.append(np.atleast_1d(np.asarray(self.velocity_function(q, v), dtype=float)))
+
+    def log(self):
+        out = {"position": np.array(self._pos)}
+        if self._vel:
+            out["velocity"] = np.array(self._vel)
+        if self.s is not None:
+            out["s"] = self.s
+        return out
+
+
+class Probe(Monitor):
+    """Any quantity ``function(t, q, v, a) -> array`` logged at the output times."""
+
+    def __init__(self, name: str, function):
+        if not callable(function):
+            raise ValueError(f"`function` must be callable, got {function!r}.")
+        self.name, self.function = str(name), function
+
+    def start(self, model, t, q, v, a):
+        self.model = model
+        self._rows = []
+
+    def sample(self, t, q, v, a):
+        self._rows.append(np.asarray(self.function(t, q, v, a), dtype=float))
+
+    def log(self):
+        return {"value": np.array(self._rows)}
