@@ -28,6 +28,8 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ._linsolve import factorize
+
 __all__ = ["NewtonOptions", "NewtonStats", "NewtonOutcome", "NewtonSolver"]
 
 #: A rate above this with a matrix evaluated during the current attempt counts
@@ -76,6 +78,13 @@ class NewtonOptions:
     retry : bool
         Modified Newton only: retry a failed solve once from the initial guess
         with a fresh matrix when the failed attempt had used a stale one.
+    xtol : float
+        Also converged when the residual stagnates at round-off level: a
+        matrix evaluated in the current attempt, a residual that fell by less
+        than half, and a correction ``max|dx| <= xtol * max(1, max|x|)``. Needed on fine meshes of stiff beams, where the
+        residual's round-off floor (about ``eps * max|K| * max|x|``: 2e-3 N
+        for B1 with 128 BE2D elements) lies above ``tol * max|r_0|``; ``0``
+        disables it. ``>= 0``.
     """
 
     tol: float = 1e-8
@@ -84,6 +93,7 @@ class NewtonOptions:
     jacobian: str = "modified"
     contraction: float = 0.3
     retry: bool = True
+    xtol: float = 1e-11
 
     def __post_init__(self):
         _real("tol", self.tol, low=0.0, high=1.0, low_open=True, high_open=True)
@@ -93,6 +103,7 @@ class NewtonOptions:
         if self.jacobian not in ("modified", "full"):
             raise ValueError(f"`jacobian` must be one of ['full', 'modified'], got {self.jacobian!r}.")
         _real("contraction", self.contraction, low=0.0, high=1.0, low_open=True, high_open=True)
+        _real("xtol", self.xtol, low=0.0)
         if not isinstance(self.retry, bool):
             raise ValueError(f"`retry` must be True or False, got {self.retry!r}.")
 
@@ -143,22 +154,12 @@ class NewtonOutcome:
 
 
 class _Factor:
-    """LU factorisation of a sparse (SuperLU) or dense (LAPACK) matrix."""
+    """LU factorisation (banded LAPACK, dense LAPACK or SuperLU; see ``_linsolve``)."""
 
     def __init__(self, matrix):
-        if sp.issparse(matrix):
-            self._lu = spla.splu(sp.csc_matrix(matrix))
-            self._dense = False
-        else:
-            arr = np.asarray(matrix, dtype=float)
-            if arr.ndim != 2 or arr.shape[0] != arr.shape[1]:
-                raise ValueError(f"the Jacobian must be a square matrix, got shape {arr.shape}.")
-            self._lu = sla.lu_factor(arr, check_finite=False)
-            self._dense = True
+        self._lu = factorize(matrix)
 
     def solve(self, rhs):
-        if self._dense:
-            return sla.lu_solve(self._lu, rhs, check_finite=False)
         return self._lu.solve(rhs)
 
 
@@ -298,6 +299,12 @@ class NewtonSolver:
             err_new = float(np.max(np.abs(r)))
             if err_new <= threshold:
                 return NewtonOutcome(x, True, k, err_new, f"converged in {k} iterations"), stale
+            # Round-off stagnation: a fresh matrix, a correction at round-off
+            # level and a residual that no longer falls -- the attainable accuracy.
+            if (fresh and err_new > 0.5 * err
+                    and np.max(np.abs(dx)) <= opts.xtol * max(1.0, float(np.max(np.abs(x))))):
+                return NewtonOutcome(x, True, k, err_new, f"converged in {k} iterations "
+                                     f"(correction at round-off level, max|r| = {err_new:.3e})"), stale
             rate = err_new / err if err > 0 else np.inf
             err = err_new
             if rate > opts.contraction:

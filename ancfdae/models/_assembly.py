@@ -12,6 +12,38 @@ import scipy.sparse as sp
 __all__ = ["Assembler"]
 
 
+def _checked_csr(data, indices, indptr, shape):
+    m = sp.csr_matrix((data, indices, indptr), shape=shape)
+    m.has_sorted_indices = True
+    return m
+
+
+def _unchecked_csr(data, indices, indptr, shape):
+    m = sp.csr_matrix.__new__(sp.csr_matrix)
+    m._shape = shape
+    m.indices, m.indptr, m.data = indices, indptr, data
+    m.maxprint = 50
+    return m
+
+
+def _select_csr_builder():
+    """Use the unchecked constructor only if it behaves exactly like scipy's on this scipy version."""
+    try:
+        ind = np.array([0, 1, 1], dtype=np.int32)
+        ptr = np.array([0, 2, 3], dtype=np.int32)
+        data = np.array([1.0, 2.0, 3.0])
+        m = _unchecked_csr(data, ind, ptr, (2, 2))
+        ref = _checked_csr(data, ind, ptr, (2, 2))
+        ok = (np.array_equal(m @ np.ones(2), ref @ np.ones(2)) and np.array_equal(m.toarray(), ref.toarray())
+              and np.array_equal(m.tocsc().toarray(), ref.toarray()) and m.indices is ind and m.has_sorted_indices)
+        return _unchecked_csr if ok else _checked_csr
+    except Exception:   # any scipy internals change: fall back to the public constructor
+        return _checked_csr
+
+
+_fast_csr = _select_csr_builder()
+
+
 class Assembler:
     """Scatter element vectors and matrices into free-coordinate arrays.
 
@@ -53,10 +85,14 @@ class Assembler:
         return np.bincount(self._slot, weights=ke.ravel()[self._mat_mask], minlength=self.nnz)
 
     def csr(self, data: np.ndarray) -> sp.csr_matrix:
-        """A CSR matrix with the fixed pattern and the given data."""
-        m = sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n_free, self.n_free))
-        m.has_sorted_indices = True
-        return m
+        """A CSR matrix with the fixed pattern and the given data.
+
+        The matrix shares this assembler's ``indices`` and ``indptr`` arrays
+        (the same objects every call), which lets solvers cache pattern
+        analyses (e.g. the band map) by identity; it skips scipy's format
+        checks, which cost more than the assembly itself on small meshes.
+        """
+        return _fast_csr(data, self.indices, self.indptr, (self.n_free, self.n_free))
 
     def matrix(self, ke: np.ndarray) -> sp.csr_matrix:
         """Assemble element matrices into a CSR matrix with the fixed pattern."""

@@ -102,109 +102,130 @@ class BE2D(Element):
         return ("x", "y", "x'", "y'")
 
     def prepare(self, q_ref, lengths):
-        geom = {"L": lengths}
-        for part, n in (("a", self.axial_points), ("b", self.bending_points)):
-            s, w = gauss(n)
-            _, dN, ddN = hermite(s, lengths)
-            Sx, Sxx = _expand2(dN), _expand2(ddN)                   # (n_el, n_pts, 2, 8)
-            geom[part] = {
-                "w": w[None, :] * lengths[:, None] / 2.0,
-                "Sx": Sx, "Sxx": Sxx,
-                "d2g": 2.0 * np.einsum("epdi,epdj->epij", Sx, Sx),
-                "d2c": (np.einsum("epdi,dk,epkj->epij", Sx, _P, Sxx)
-                        + np.einsum("epdi,kd,epkj->epij", Sxx, _P, Sx)),
-            }
-            g, c, *_ = self._invariants(geom[part], q_ref, derivatives=False)
-            geom[part]["eps_ref"] = np.sqrt(g) - 1.0
-            geom[part]["K_ref"] = c / g
+        # One concatenated point set: the axial rule's points first, then the
+        # bending rule's; masks select which density acts where. Arrays are
+        # stored points-last ("structure of arrays", (..., n_el, n_pts)) so that
+        # every elementwise operation runs over all elements x points at once.
+        sa, wa = gauss(self.axial_points)
+        sb, wb = gauss(self.bending_points)
+        s = np.concatenate([sa, sb])
+        w = np.concatenate([wa, wb])
+        _, dN, ddN = hermite(s, lengths)                         # (n_el, n_pts, 4)
+        n_el, n_pts = dN.shape[:2]
+        is_a = np.zeros(n_pts, dtype=bool)
+        is_a[:sa.size] = True
+        geom = {"L": lengths, "w": w[None, :] * lengths[:, None] / 2.0,
+                "dN_e": dN, "ddN_e": ddN,                                   # (n_el, n_pts, 4): for r', r''
+                "dN": np.ascontiguousarray(dN.transpose(2, 0, 1))[:, None],  # (4, 1, n_el, n_pts)
+                "ddN": np.ascontiguousarray(ddN.transpose(2, 0, 1))[:, None],
+                "is_a": is_a, "is_b": ~is_a}
+        # Constant Hessians of g = r'.r' and c = (r' x r'').e_z, stacked as (n_el, 2*n_pts, 64).
+        I2 = np.eye(2)
+        d2g = 2.0 * np.einsum("epk,epl,ab->epkalb", dN, dN, I2)
+        d2c = np.einsum("epk,epl,ab->epkalb", dN, ddN, _P) + np.einsum("epk,epl,ab->epkalb", ddN, dN, _P.T)
+        geom["d2"] = np.stack([d2g.reshape(n_el, n_pts, 64), d2c.reshape(n_el, n_pts, 64)], axis=1
+                              ).reshape(n_el, 2 * n_pts, 64)
+        g, c = self._invariants(geom, q_ref, derivatives=False)
+        geom["eps_ref"] = np.sqrt(g) - 1.0
+        geom["K_ref"] = c / g
         if self.formulation == "continuum":
-            bent = max(np.abs(geom["a"]["eps_ref"]).max(), np.abs(geom["b"]["K_ref"]).max() * lengths.max())
+            bent = max(np.abs(geom["eps_ref"]).max(), np.abs(geom["K_ref"]).max() * lengths.max())
             if bent > 1e-10:
                 raise ValueError("formulation='continuum' needs a straight, unstretched reference configuration; "
                                  f"the given nodes have |eps_ref|, |K_ref| L up to {bent:.3g}.")
-        s, w = gauss(4)   # cubic x cubic: exact with 4 points
-        N, _, _ = hermite(s, lengths)
-        m = np.einsum("ep,epi,epj->eij", w[None, :] * lengths[:, None] / 2, N, N)
+        sm, wm = gauss(4)   # cubic x cubic: exact with 4 points
+        N, _, _ = hermite(sm, lengths)
+        m = np.einsum("ep,epi,epj->eij", wm[None, :] * lengths[:, None] / 2, N, N)
         rhoA = self.material.rho * self.section.A
-        geom["M"] = rhoA * np.einsum("eij,kl->eikjl", m, np.eye(2)).reshape(-1, 8, 8)
+        geom["M"] = rhoA * np.einsum("eij,kl->eikjl", m, I2).reshape(-1, 8, 8)
         return geom
 
     # -- kernels --------------------------------------------------------
     @staticmethod
-    def _invariants(part, q, derivatives=True):
-        r1 = np.einsum("epdi,ei->epd", part["Sx"], q)
-        r2 = np.einsum("epdi,ei->epd", part["Sxx"], q)
-        g = np.einsum("epd,epd->ep", r1, r1)
-        c = r1[..., 0] * r2[..., 1] - r1[..., 1] * r2[..., 0]
+    def _invariants(geom, q, derivatives=True):
+        """g, c at every point, shape (n_el, n_pts), and if asked dg, dc of shape (4, 2, n_el, n_pts)."""
+        Q = q.reshape(q.shape[0], 4, 2)
+        r1 = np.ascontiguousarray((geom["dN_e"] @ Q).transpose(2, 0, 1))      # (2, n_el, n_pts)
+        r2 = np.ascontiguousarray((geom["ddN_e"] @ Q).transpose(2, 0, 1))
+        g = r1[0] * r1[0] + r1[1] * r1[1]
+        c = r1[0] * r2[1] - r1[1] * r2[0]
         if not derivatives:
             return g, c
-        dg = 2.0 * np.einsum("epdi,epd->epi", part["Sx"], r1)
-        # dc = Sx^T P r'' + Sxx^T P^T r'
-        dc = (np.einsum("epdi,dk,epk->epi", part["Sx"], _P, r2)
-              + np.einsum("epdi,kd,epk->epi", part["Sxx"], _P, r1))
+        dN, ddN = geom["dN"], geom["ddN"]
+        dg = dN * (2.0 * r1)
+        # dc = Sx^T P r'' + Sxx^T P^T r', with P r'' = (r''_y, -r''_x), P^T r' = (-r'_y, r'_x)
+        r2[0] *= -1.0
+        r1[1] *= -1.0
+        dc = dN * r2[::-1] + ddN * r1[::-1]
         return g, c, dg, dc
 
-    def _densities(self, part_name, g, c, geom, order):
-        """Energy density W and its derivatives in (g, c) at the points of one rule."""
+    def _densities(self, g, c, geom, hessian=True):
+        """Energy density derivatives in (g, c): (W, Wg, Wc[, Wgg, Wgc, Wcc]), each (n_el, n_pts).
+
+        Axial terms act at the axial rule's points, bending terms at the
+        bending rule's points.
+        """
         E, sec = self.material.E, self.section
         EA, EI = E * sec.A, E * sec.I3
-        part = geom[part_name]
-        zero = np.zeros_like(g)
+        a_pts, b_pts = geom["is_a"], geom["is_b"]
         if self.formulation == "structural":
-            if part_name == "a":
-                a = 1.0 + part["eps_ref"]
-                rg = np.sqrt(g)
-                d = rg - a
-                return (0.5 * EA * d**2, EA * (0.5 - a / (2 * rg)), zero, EA * a / (4 * g * rg), zero, zero)
+            a = 1.0 + geom["eps_ref"]
+            rg = np.sqrt(g)
+            Kr = geom["K_ref"]
             K = c / g
-            dK = K - part["K_ref"]
-            return (0.5 * EI * dK**2, -EI * dK * K / g, EI * dK / g,
-                    EI * (3 * K**2 - 2 * part["K_ref"] * K) / g**2, -EI * (2 * K - part["K_ref"]) / g**2, EI / g**2)
-        if part_name == "a":
-            a = 0.5 * (g - 1.0)
-            return (0.5 * EA * a**2, 0.5 * EA * a, zero, np.full_like(g, 0.25 * EA), zero, zero)
+            dK = K - Kr
+            W = np.where(a_pts, 0.5 * EA * (rg - a) ** 2, 0.5 * EI * dK**2)
+            Wg = np.where(a_pts, EA * (0.5 - a / (2 * rg)), -EI * dK * K / g)
+            Wc = (EI * b_pts) * dK / g
+            if not hessian:
+                return W, Wg, Wc
+            Wgg = np.where(a_pts, EA * a / (4 * g * rg), EI * (3 * K**2 - 2 * Kr * K) / g**2)
+            Wgc = (-EI * b_pts) * (2 * K - Kr) / g**2
+            Wcc = (EI * b_pts) / g**2
+            return W, Wg, Wc, Wgg, Wgc, Wcc
+        a = 0.5 * (g - 1.0)
         I, I4 = sec.I3, sec.I4
-        phi = 1.5 / g - 0.5 / g**2
-        phi1 = -1.5 / g**2 + 1.0 / g**3
-        phi2 = 3.0 / g**3 - 3.0 / g**4
-        psi, psi1, psi2 = 0.25 / g**4, -1.0 / g**5, 5.0 / g**6
-        W = 0.5 * E * (I * c**2 * phi + I4 * c**4 * psi)
-        Wg = 0.5 * E * (I * c**2 * phi1 + I4 * c**4 * psi1)
-        Wc = E * (I * c * phi + 2 * I4 * c**3 * psi)
-        Wgg = 0.5 * E * (I * c**2 * phi2 + I4 * c**4 * psi2)
-        Wgc = E * (I * c * phi1 + 2 * I4 * c**3 * psi1)
-        Wcc = E * (I * phi + 6 * I4 * c**2 * psi)
+        ig = 1.0 / g
+        phi = (1.5 - 0.5 * ig) * ig
+        phi1 = (-1.5 + ig) * ig**2
+        psi, psi1 = 0.25 * ig**4, -ig**5
+        c2 = c * c
+        W = np.where(a_pts, 0.5 * EA * a**2, 0.5 * E * (I * c2 * phi + I4 * c2 * c2 * psi))
+        Wg = np.where(a_pts, 0.5 * EA * a, 0.5 * E * (I * c2 * phi1 + I4 * c2 * c2 * psi1))
+        Wc = (E * b_pts) * (I * c * phi + 2 * I4 * c2 * c * psi)
+        if not hessian:
+            return W, Wg, Wc
+        phi2 = (3.0 - 3.0 * ig) * ig**3
+        psi2 = 5.0 * ig**6
+        Wgg = np.where(a_pts, 0.25 * EA, 0.5 * E * (I * c2 * phi2 + I4 * c2 * c2 * psi2))
+        Wgc = (E * b_pts) * (I * c * phi1 + 2 * I4 * c2 * c * psi1)
+        Wcc = (E * b_pts) * (I * phi + 6 * I4 * c2 * psi)
         return W, Wg, Wc, Wgg, Wgc, Wcc
 
     def mass_matrix(self, geom):
         return geom["M"]
 
     def strain_energy(self, geom, q):
-        U = 0.0
-        for name in ("a", "b"):
-            g, c = self._invariants(geom[name], q, derivatives=False)
-            U = U + np.einsum("ep,ep->e", geom[name]["w"], self._densities(name, g, c, geom, 0)[0])
-        return U
+        g, c = self._invariants(geom, q, derivatives=False)
+        return np.sum(geom["w"] * self._densities(g, c, geom, hessian=False)[0], axis=1)
 
     def internal_forces(self, geom, q, tangent=True):
-        f = np.zeros(q.shape)
-        K = np.zeros(q.shape + (q.shape[-1],)) if tangent else None
-        for name in ("a", "b"):
-            part = geom[name]
-            w = part["w"]
-            g, c, dg, dc = self._invariants(part, q)
-            _, Wg, Wc, Wgg, Wgc, Wcc = self._densities(name, g, c, geom, 2)
-            f += np.einsum("ep,epi->ei", w * Wg, dg)
-            if name == "b" or self.formulation == "continuum":
-                f += np.einsum("ep,epi->ei", w * Wc, dc)
-            if tangent:
-                K += np.einsum("ep,epi,epj->eij", w * Wgg, dg, dg)
-                K += np.einsum("ep,epij->eij", w * Wg, part["d2g"])
-                if name == "b":
-                    K += np.einsum("ep,epi,epj->eij", w * Wcc, dc, dc)
-                    K += np.einsum("ep,epi,epj->eij", w * Wgc, dg, dc)
-                    K += np.einsum("ep,epi,epj->eij", w * Wgc, dc, dg)
-                    K += np.einsum("ep,epij->eij", w * Wc, part["d2c"])
+        w = geom["w"]
+        g, c, dg, dc = self._invariants(geom, q)
+        D = self._densities(g, c, geom, hessian=tangent)
+        n_el, n_pts = g.shape
+        # f_i = sum_p w (Wg dg_i + Wc dc_i)
+        wg, wc = w * D[1], w * D[2]
+        f = (np.sum(dg * wg + dc * wc, axis=-1)).reshape(8, n_el).T
+        if not tangent:
+            return f, None
+        Wgg, Wgc, Wcc = w * D[3], w * D[4], w * D[5]
+        Bg = dg * Wgg + dc * Wgc                         # H A, row g
+        Bc = dg * Wgc + dc * Wcc                         # H A, row c
+        A = np.concatenate([dg, dc], axis=-1).reshape(8, n_el, 2 * n_pts).transpose(1, 0, 2)
+        B = np.concatenate([Bg, Bc], axis=-1).reshape(8, n_el, 2 * n_pts).transpose(1, 2, 0)
+        first = np.stack([wg, wc], axis=1).reshape(n_el, 1, 2 * n_pts)
+        K = A @ B + (first @ geom["d2"]).reshape(n_el, 8, 8)
         return f, K
 
     def shape_matrix(self, s, lengths):
