@@ -2,5 +2,7 @@
 from ._element import Element
 from .beam import Beam
 from .be2d import BE2D
+from .sq2d import SQ2D
+from .sq3d import SQ3D
 
-__all__ = ["Element", "Beam", "BE2D"]
+__all__ = ["Element", "Beam", "BE2D", "SQ2D", "SQ3D"]
