@@ -1,0 +1,103 @@
+"""Figures of the flying-beam studies (PNG, small: dpi 100)."""
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["figure", "plot_flying2d", "plot_flying3d"]
+
+_STYLE = {"BE2D": "C0", "SQ2D": "C1", "BE3D": "C2", "SQ3D": "C3"}
+
+
+def figure(*args, **kw):
+    """A matplotlib figure with the Agg backend (no display needed)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt.subplots(*args, **kw)
+
+
+def save(fig, path, name):
+    import matplotlib.pyplot as plt
+    fig.tight_layout()
+    fig.savefig(path / name, dpi=100)
+    plt.close(fig)
+
+
+def plot_flying2d(rows, refs, path):
+    """Fig. 8 (eps_T against elements and DOF), Fig. 9 (CPU against eps_T), tip path and energy."""
+    names = list(dict.fromkeys(r["element"] for r in rows))
+    ok = [r for r in rows if np.isfinite(r["eps_T"]) and r["eps_T"] > 0]
+    fig, axes = figure(1, 2, figsize=(10, 4))
+    for name in names:
+        rs = [r for r in ok if r["element"] == name]
+        ls = "o-" if name.endswith("2D") else "s--"
+        axes[0].loglog([r["n"] for r in rs], [r["eps_T"] for r in rs], ls, color=_STYLE.get(name), label=name)
+        axes[1].loglog([r["dof"] for r in rs], [r["eps_T"] for r in rs], ls, color=_STYLE.get(name), label=name)
+    if ok:
+        n = np.array([4.0, max(r["n"] for r in ok)])
+        e4 = max(r["eps_T"] for r in ok if r["n"] == min(r["n"] for r in ok))
+        axes[0].loglog(n, e4 * 0.1 * (n / 4) ** -4, "k:", label="order 4")
+    axes[0].set(xlabel="number of elements", ylabel="eps_T (Eq. 115)")
+    axes[1].set(xlabel="degrees of freedom", ylabel="eps_T (Eq. 115)")
+    for ax in axes:
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend()
+    fig.suptitle("B2 beam flying in plane: integrated tip error (chapter Fig. 8)")
+    save(fig, path, "fig8_convergence.png")
+
+    fig, ax = figure(figsize=(5.5, 4))
+    for name in names:
+        rs = [r for r in ok if r["element"] == name]
+        ax.loglog([r["eps_T"] for r in rs], [r["cpu"] for r in rs], "o-", color=_STYLE.get(name), label=name)
+    ax.set(xlabel="eps_T (Eq. 115)", ylabel="CPU time (s)", title="B2: CPU time against error (chapter Fig. 9)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    save(fig, path, "fig9_performance.png")
+
+    fig, axes = figure(1, 2, figsize=(10, 4))
+    for fam, r in refs.items():
+        axes[0].plot(r["tip"][:, 0], r["tip"][:, 1], label=f"{r['element']} {r['n']} el")
+        if r["energy"] is not None:
+            axes[1].plot(r["t"], r["energy"]["total"], label=f"T + U, {r['element']}")
+            axes[1].plot(r["t"], r["energy"]["work"], "--", label=f"work of the loads, {r['element']}")
+    axes[0].set(xlabel="x_B (m)", ylabel="y_B (m)", title="path of the tip B (reference)")
+    axes[0].set_aspect("equal", adjustable="datalim")
+    axes[1].set(xlabel="t (s)", ylabel="energy (J)", title="energy (reference)")
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+    save(fig, path, "b2_tip_energy.png")
+
+
+def plot_flying3d(records, path):
+    """Fig. 11 (total energy against time) and Fig. 12 (displacement components of B)."""
+    fig, ax = figure(figsize=(7, 4.2))
+    for r in records:
+        if r["energy"] is None:
+            continue
+        ls = "-" if r["element"] == "SQ3D" else "--"
+        ax.plot(r["t"], r["energy"]["kinetic"] + r["energy"]["strain"], ls, lw=1,
+                label=f"{r['element']} {r['n']} el" + ("" if r["status"] == "success" else f" (fails {r['t_end_reached']:.2f} s)"))
+    ax.set(xlabel="t (s)", ylabel="T + U (J)", title="B3: total energy (chapter Fig. 11)")
+    ymax = max((np.nanmax(r["energy"]["kinetic"] + r["energy"]["strain"]) for r in records
+                if r["element"] == "SQ3D" and r["energy"] is not None), default=None)
+    if ymax:
+        ax.set_ylim(0, 2.5 * ymax)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    save(fig, path, "fig11_energy.png")
+
+    kinds = list(dict.fromkeys(r["element"] for r in records))
+    fig, axes = figure(3, len(kinds), figsize=(5 * len(kinds), 7), sharex=True, squeeze=False)
+    for j, kind in enumerate(kinds):
+        for r in (r for r in records if r["element"] == kind):
+            u = r["tip"] - r["tip"][:1]
+            for i in range(3):
+                axes[i, j].plot(r["t"], u[:, i], lw=1, label=f"{r['n']} el")
+        axes[0, j].set_title(f"{kind}: displacement of B (chapter Fig. 12)")
+        for i, c in enumerate("xyz"):
+            axes[i, j].set_ylabel(f"u_{c} (m)")
+            axes[i, j].grid(True, alpha=0.3)
+        axes[0, j].legend(fontsize=8)
+        axes[2, j].set_xlabel("t (s)")
+    save(fig, path, "fig12_displacement.png")
