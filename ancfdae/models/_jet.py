@@ -7,7 +7,9 @@ reciprocals of at most six variables, so it is propagated here as a jet:
 value ``v`` of shape ``(P, *shape)``, gradient ``g`` ``(P, *shape, K)`` and
 Hessian ``h`` ``(P, *shape, K, K)`` over ``K`` variables, for ``P`` points at
 once (no loop over points). Every rule is the plain product or chain rule, so
-the derivatives are exact to rounding.
+the derivatives are exact to rounding. A jet of order 1 carries no Hessian
+(``h is None``), one of order 0 no gradient either: the residual pays only for
+what it uses.
 """
 from __future__ import annotations
 
@@ -21,77 +23,95 @@ class Jet:
 
     __slots__ = ("v", "g", "h")
 
-    def __init__(self, v, g, h):
+    def __init__(self, v, g=None, h=None):
         self.v, self.g, self.h = v, g, h
 
     @property
     def is_vector(self) -> bool:
         return self.v.ndim == 2
 
-    def __add__(self, other: "Jet") -> "Jet":
-        return Jet(self.v + other.v, self.g + other.g, self.h + other.h)
-
-    def __sub__(self, other: "Jet") -> "Jet":
-        return Jet(self.v - other.v, self.g - other.g, self.h - other.h)
-
     def __neg__(self) -> "Jet":
-        return Jet(-self.v, -self.g, -self.h)
+        return Jet(-self.v, None if self.g is None else -self.g, None if self.h is None else -self.h)
 
 
-def variables(*blocks: np.ndarray, derivatives: bool = True) -> list[Jet]:
-    """Vector jets of independent variables, one per block of shape ``(P, d)``.
-
-    With ``derivatives=False`` the jets carry no variables (K = 0): values only.
-    """
+def variables(*blocks: np.ndarray, order: int = 2) -> list[Jet]:
+    """Vector jets of the independent variables, one per block of shape ``(P, d)``."""
     P = blocks[0].shape[0]
-    K = sum(b.shape[1] for b in blocks) if derivatives else 0
+    K = sum(b.shape[1] for b in blocks)
     out, k = [], 0
     for b in blocks:
         d = b.shape[1]
-        g = np.zeros((P, d, K))
-        if derivatives:
+        g = h = None
+        if order >= 1:
+            g = np.zeros((P, d, K))
             g[:, np.arange(d), k + np.arange(d)] = 1.0
-            k += d
-        out.append(Jet(b, g, np.zeros((P, d, K, K))))
+        if order >= 2:
+            h = np.zeros((P, d, K, K))
+        k += d
+        out.append(Jet(b, g, h))
     return out
+
+
+def _sym(o):
+    return o + np.swapaxes(o, -1, -2)
 
 
 def mul(a: Jet, b: Jet) -> Jet:
     """Scalar jet ``a`` times scalar or vector jet ``b``."""
-    if b.is_vector:
-        av, ag, ah = a.v[:, None], a.g[:, None, :], a.h[:, None, :, :]
-    else:
-        av, ag, ah = a.v, a.g, a.h
-    o = ag[..., :, None] * b.g[..., None, :]
-    return Jet(av * b.v, av[..., None] * b.g + ag * b.v[..., None],
-               av[..., None, None] * b.h + ah * b.v[..., None, None] + o + np.swapaxes(o, -1, -2))
+    e = (slice(None), None) if b.is_vector else (slice(None),)
+    av = a.v[e]
+    v = av * b.v
+    if a.g is None:
+        return Jet(v)
+    ag = a.g[e]
+    g = av[..., None] * b.g + ag * b.v[..., None]
+    if a.h is None:
+        return Jet(v, g)
+    h = av[..., None, None] * b.h + a.h[e] * b.v[..., None, None] + _sym(ag[..., :, None] * b.g[..., None, :])
+    return Jet(v, g, h)
 
 
 def dot(a: Jet, b: Jet) -> Jet:
     """Scalar product of two vector jets."""
     v = np.einsum("pc,pc->p", a.v, b.v)
+    if a.g is None:
+        return Jet(v)
     g = np.einsum("pck,pc->pk", a.g, b.v) + np.einsum("pc,pck->pk", a.v, b.g)
-    o = np.einsum("pck,pcl->pkl", a.g, b.g)
+    if a.h is None:
+        return Jet(v, g)
     h = (np.einsum("pckl,pc->pkl", a.h, b.v) + np.einsum("pc,pckl->pkl", a.v, b.h)
-         + o + np.swapaxes(o, -1, -2))
+         + _sym(np.einsum("pck,pcl->pkl", a.g, b.g)))
     return Jet(v, g, h)
+
+
+def _cx(x, y):
+    """Cross product over axis 1 (broadcasting over the trailing axes)."""
+    return np.stack([x[:, 1] * y[:, 2] - x[:, 2] * y[:, 1],
+                     x[:, 2] * y[:, 0] - x[:, 0] * y[:, 2],
+                     x[:, 0] * y[:, 1] - x[:, 1] * y[:, 0]], axis=1)
 
 
 def cross(a: Jet, b: Jet) -> Jet:
     """Cross product of two 3-vector jets."""
-    def cx(x, y):
-        return np.cross(x, y, axisa=1, axisb=1, axisc=1)
-    v = cx(a.v, b.v)
-    g = cx(a.g, b.v[:, :, None]) + cx(a.v[:, :, None], b.g)
-    o = cx(a.g[:, :, :, None], b.g[:, :, None, :])          # (k, l) entry: a_k x b_l
-    h = cx(a.h, b.v[:, :, None, None]) + cx(a.v[:, :, None, None], b.h) + o + np.swapaxes(o, -1, -2)
+    v = _cx(a.v, b.v)
+    if a.g is None:
+        return Jet(v)
+    g = _cx(a.g, b.v[:, :, None]) + _cx(a.v[:, :, None], b.g)
+    if a.h is None:
+        return Jet(v, g)
+    h = (_cx(a.h, b.v[:, :, None, None]) + _cx(a.v[:, :, None, None], b.h)
+         + _sym(_cx(a.g[:, :, :, None], b.g[:, :, None, :])))    # a_k x b_l + a_l x b_k
     return Jet(v, g, h)
 
 
 def _unary(a: Jet, f, f1, f2) -> Jet:
-    """Chain rule for a scalar function with value f, first and second derivatives f1, f2."""
-    return Jet(f, f1[..., None] * a.g,
-               f1[..., None, None] * a.h + f2[..., None, None] * a.g[..., :, None] * a.g[..., None, :])
+    """Chain rule for a scalar function with value f and derivatives f1, f2 at ``a.v``."""
+    if a.g is None:
+        return Jet(f)
+    g = f1[..., None] * a.g
+    if a.h is None:
+        return Jet(f, g)
+    return Jet(f, g, f1[..., None, None] * a.h + f2[..., None, None] * a.g[..., :, None] * a.g[..., None, :])
 
 
 def sqrt(a: Jet) -> Jet:
@@ -106,13 +126,15 @@ def recip(a: Jet) -> Jet:
 
 def linear(M: np.ndarray, a: Jet) -> Jet:
     """Constant matrix ``M`` (d x d) applied to the components of a vector jet."""
-    return Jet(np.einsum("ij,pj->pi", M, a.v), np.einsum("ij,pjk->pik", M, a.g),
-               np.einsum("ij,pjkl->pikl", M, a.h))
+    return Jet(np.einsum("ij,pj->pi", M, a.v), None if a.g is None else np.einsum("ij,pjk->pik", M, a.g),
+               None if a.h is None else np.einsum("ij,pjkl->pikl", M, a.h))
 
 
 def combine(weights, jets: list[Jet]) -> Jet:
     """``sum_k weights[k] * jets[k]`` with per-point constant weights (arrays of shape (P,))."""
-    def w_(w, x):
-        return w.reshape(w.shape + (1,) * (x.ndim - 1)) * x
-    return Jet(sum(w_(w, j.v) for w, j in zip(weights, jets)), sum(w_(w, j.g) for w, j in zip(weights, jets)),
-               sum(w_(w, j.h) for w, j in zip(weights, jets)))
+    def part(name):
+        xs = [getattr(j, name) for j in jets]
+        if xs[0] is None:
+            return None
+        return sum(w.reshape(w.shape + (1,) * (x.ndim - 1)) * x for w, x in zip(weights, xs))
+    return Jet(part("v"), part("g"), part("h"))

@@ -64,16 +64,19 @@ class SQElement(Element):
         terms -- full integration locks in shear -- and the end-point
         (Lobatto) rule with one point per node for the cross-section terms,
         which penalises the thickness strain at the nodes and so leaves no
-        zero-energy mode. These rules reproduce the chapter's Table 2.
-        Continuum: 3 Gauss points along the axis (quadratic element; 2 for
-        the linear one), 3 x 3 over the section (exact for the quartic
-        St. Venant-Kirchhoff energy of a rectangle).
+        zero-energy mode. These rules reproduce the chapter's Table 2 to 4
+        digits; no other combination of 1-5 point rules does (tests).
+        Continuum: the same reduced Gauss rule along the axis (full
+        integration locks in shear here too: 3 points make one quadratic
+        element 5 % too stiff in bending), 3 x 3 Gauss points over a
+        rectangular section (exact for the quartic St. Venant-Kirchhoff
+        energy); ``{"axial": 3}`` is Chrono's full integration (benchmarks.md B4).
         """
         n = self.nodes
         if self.formulation == "structural":
             return {"axial": ("gauss", n - 1), "shear": ("gauss", n - 1), "bending": ("gauss", n - 1),
                     "cross_section": ("lobatto", n)}
-        return {"axial": ("gauss", n), "section": ("gauss", 3)}
+        return {"axial": ("gauss", n - 1), "section": ("gauss", 3)}
 
     def _parse_quadrature(self, spec):
         rules = self.default_quadrature()
@@ -127,29 +130,27 @@ class SQElement(Element):
         raise NotImplementedError
 
     def _prepare_structural(self, geom, q_ref, lengths):
-        distinct = sorted(set(self.quadrature[t] for t in _STRUCTURAL_TERMS))
-        pts, wts, owner = [], [], []
-        for r in distinct:
+        # One group of points per distinct rule, each evaluating only the strains of its terms
+        # (the frame of Eq. 7 is not computed at points that carry the cross-section terms only).
+        groups = []
+        for r in sorted(set(self.quadrature[t] for t in _STRUCTURAL_TERMS)):
+            which = [k for k, t in enumerate(self._terms) if self.quadrature[t] == r]
             s, w = rule(*r)
-            pts.append(s)
-            wts.append(w)
-            owner += [r] * len(s)
-        s, w = np.concatenate(pts), np.concatenate(wts)
-        N, dN = shapes(self.nodes, s, lengths)
-        B = local_map(N, dN, self.dim)
-        E, P = B.shape[:2]
-        v = np.einsum("epvi,ei->epv", B, q_ref).reshape(E * P, -1)
-        npv = self.dim * (self.dim - 1)
-        jac = np.linalg.norm(v[:, npv:npv + self.dim], axis=1)      # |r_ref'| = dS/dxi (Eq. 15)
-        zeros = np.zeros((E * P, len(self._terms)))
-        _, _, _, raw = structural_kernel(self._strains, v, self.dim, zeros, zeros, 0)
-        # Strains per unit arc length S (Eqs. 16, 19): divide by dS/dxi; energy over dS.
-        cs = np.array([t == "cross_section" for t in self._terms])
-        scale = np.where(cs[None, :], jac[:, None], 1.0 / jac[:, None])
-        use = np.array([[owner[p] == self.quadrature[t] for t in self._terms] for p in range(P)], dtype=float)
-        Dw = (self._stiffness()[None, None, :] * use[None] * (w[None, :, None] * lengths[:, None, None] / 2)
-              ).reshape(E * P, -1) * scale
-        geom.update(B=B, ref=raw, Dw=Dw)
+            N, dN = shapes(self.nodes, s, lengths)
+            B = local_map(N, dN, self.dim)
+            E, P = B.shape[:2]
+            v = np.einsum("epvi,ei->epv", B, q_ref).reshape(E * P, -1)
+            npv = self.dim * (self.dim - 1)
+            jac = np.linalg.norm(v[:, npv:npv + self.dim], axis=1)      # |r_ref'| = dS/dxi (Eq. 15)
+            zeros = np.zeros((E * P, len(which)))
+            _, _, _, raw = structural_kernel(self._strains, which, v, self.dim, zeros, zeros, 0)
+            # Strains per unit arc length S (Eqs. 16, 19) integrated over dS; cross-section strains over dS.
+            cs = np.array([self._terms[k] == "cross_section" for k in which])
+            scale = np.where(cs[None, :], jac[:, None], 1.0 / jac[:, None])
+            wq = (w[None, :] * lengths[:, None] / 2).reshape(-1)
+            Dw = self._stiffness()[which][None, :] * wq[:, None] * scale
+            groups.append({"which": which, "B": B, "ref": raw, "Dw": Dw})
+        geom["groups"] = groups
 
     def _section_points(self):
         """Cross-section points ``(S, dim-1)`` and area weights for the continuum energy."""
@@ -220,7 +221,7 @@ class SQElement(Element):
         _, T = voigt(self.dim)
         ref = 0.5 * np.einsum("acd,pscd->psa", T, C)
         wax = (w[None, :] * lengths[:, None] / 2).reshape(-1)
-        geom.update(B=B, Pc=Pc, ws=ws, Ds=Ds, ref=ref, wax=wax)
+        geom["groups"] = [{"B": B, "Pc": Pc, "ws": ws, "Ds": Ds, "ref": ref, "wax": wax}]
 
     def _mass(self, lengths, q_ref):
         """``rho int S^T S dV`` (Eq. 27): ``rho int N_i N_j dS`` times diag(A, I3, I2) per node vector."""
@@ -238,27 +239,35 @@ class SQElement(Element):
 
     # -- kernels ----------------------------------------------------------------------------
     def _evaluate(self, geom, q, order):
-        B = geom["B"]
-        E, P = B.shape[:2]
-        v = np.einsum("epvi,ei->epv", B, q).reshape(E * P, -1)
-        if self.formulation == "structural":
-            W, g, H, _ = structural_kernel(self._strains, v, self.dim, geom["ref"], geom["Dw"], order)
-        else:
-            W, g, H = continuum_kernel(v, self.dim, geom["Pc"], geom["ws"], geom["Ds"], geom["ref"],
-                                       geom["wax"], order)
-        nv = v.shape[1]
-        return (W.reshape(E, P), None if g is None else g.reshape(E, P, nv),
-                None if H is None else H.reshape(E, P, nv, nv))
+        """Per point group: energy (n_el,), force and tangent (or None) of the elements."""
+        q = np.asarray(q, dtype=float)
+        W, f, K = 0.0, 0.0, None
+        for grp in geom["groups"]:
+            B = grp["B"]
+            E, P, nv = B.shape[:3]
+            v = np.einsum("epvi,ei->epv", B, q).reshape(E * P, nv)
+            if self.formulation == "structural":
+                w, g, H, _ = structural_kernel(self._strains, grp["which"], v, self.dim, grp["ref"], grp["Dw"],
+                                               order)
+            else:
+                w, g, H = continuum_kernel(v, self.dim, grp["Pc"], grp["ws"], grp["Ds"], grp["ref"], grp["wax"],
+                                           order)
+            W = W + w.reshape(E, P).sum(axis=1)
+            if order >= 1:
+                fg, Kg = assemble(B, g.reshape(E, P, nv), None if H is None else H.reshape(E, P, nv, nv))
+                f = f + fg
+                K = Kg if K is None else K + Kg
+        return W, f, K
 
     def mass_matrix(self, geom):
         return geom["M"]
 
     def strain_energy(self, geom, q):
-        return self._evaluate(geom, np.asarray(q, dtype=float), 0)[0].sum(axis=1)
+        return self._evaluate(geom, q, 0)[0]
 
     def internal_forces(self, geom, q, tangent=True):
-        _, g, H = self._evaluate(geom, np.asarray(q, dtype=float), 2 if tangent else 1)
-        return assemble(geom["B"], g, H)
+        _, f, K = self._evaluate(geom, q, 2 if tangent else 1)
+        return f, K
 
     def shape_matrix(self, s, lengths):
         N, _ = shapes(self.nodes, np.asarray(s, dtype=float), np.asarray(lengths, dtype=float))

@@ -67,18 +67,20 @@ def assemble(B: np.ndarray, g: np.ndarray, H: np.ndarray | None):
 
 
 # -- structural mechanics formulation -------------------------------------------------------------
-def structural_kernel(strains, v: np.ndarray, dim: int, ref: np.ndarray, Dw: np.ndarray, order: int):
+def structural_kernel(strains, which, v: np.ndarray, dim: int, ref: np.ndarray, Dw: np.ndarray, order: int):
     """Energy, gradient and Hessian of ``W = 1/2 sum_k Dw_k (eps_k - ref_k)^2`` in the local variables.
 
     Parameters
     ----------
     strains : callable
-        ``strains(p_jets) -> list`` over strain components ``k`` of pairs
+        ``strains(p_jets, which) -> list`` over the strain components ``k`` in ``which`` of pairs
         ``(terms, s)``: ``eps_k = sum_(j, c) c(p) . d_j + s(p)``, with ``c`` a
         vector jet multiplying derivative block ``j`` and ``s`` a scalar jet or
         None. Every strain of chapter Eqs. 16, 25, 45 has this form: linear in
         the derivatives ``d``, nonlinear in the slopes ``p`` only.
     v : ndarray, shape (P, n_v)
+    which : sequence of int
+        The strain components evaluated here (those whose term uses these points).
     ref : ndarray, shape (P, n_strain)
         Raw strain values of the reference configuration (subtracted).
     Dw : ndarray, shape (P, n_strain)
@@ -92,9 +94,9 @@ def structural_kernel(strains, v: np.ndarray, dim: int, ref: np.ndarray, Dw: np.
     """
     P = v.shape[0]
     npv = dim * (dim - 1)
-    pj = variables(*[v[:, k * dim:(k + 1) * dim] for k in range(dim - 1)], derivatives=order >= 1)
+    pj = variables(*[v[:, k * dim:(k + 1) * dim] for k in range(dim - 1)], order=order)
     d = [v[:, npv + j * dim: npv + (j + 1) * dim] for j in range(dim)]
-    comps = strains(pj)
+    comps = strains(pj, which)
     raw = np.stack([sum(np.einsum("pc,pc->p", c.v, d[j]) for j, c in terms) + (s.v if s is not None else 0.0)
                     for terms, s in comps], axis=1)
     eps = raw - ref
@@ -113,7 +115,7 @@ def structural_kernel(strains, v: np.ndarray, dim: int, ref: np.ndarray, Dw: np.
     g = np.einsum("pk,pkv->pv", sig, Jm)
     if order == 1:
         return W, g, None, eps
-    H = np.einsum("pkv,pk,pkw->pvw", Jm, Dw, Jm)
+    H = np.swapaxes(Jm, 1, 2) @ (Dw[:, :, None] * Jm)
     # Second-derivative part sum_k sig_k d2 eps_k: combine the jets per derivative block first.
     for j in range(dim):
         ks = [(k, c) for k, (terms, _) in enumerate(comps) for jj, c in terms if jj == j]

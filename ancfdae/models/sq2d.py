@@ -57,16 +57,17 @@ class SQ2D(SQElement):
         return np.array([m.E * s.A, s.k_s(m) * m.G * s.A, m.E * s.I3, m.E * s.A])
 
     @staticmethod
-    def _strains(p):
-        """``(terms, s)`` of Gamma_1, Gamma_2, kappa, E_22; derivative blocks 0 = r', 1 = a'."""
+    def _strains(p, which):
+        """``(terms, s)`` of Gamma_1, Gamma_2, kappa, E_22 (those in ``which``); blocks 0 = r', 1 = a'."""
         a = p[0]
         aa = dot(a, a)
-        e2 = mul(recip(sqrt(aa)), a)
-        e1 = linear(_TURN, e2)
-        # (a x a').e_z / |a|^2 = a' . (-TURN a) / |a|^2
-        kap = mul(recip(aa), linear(-_TURN, a))
-        half = combine([np.full(aa.v.shape, 0.5)], [aa])
-        return [([(0, e1)], None), ([(0, e2)], None), ([(1, kap)], None), ([], half)]
+        out = {3: ([], combine([np.full(aa.v.shape, 0.5)], [aa]))}
+        if any(k < 3 for k in which):
+            e2 = mul(recip(sqrt(aa)), a)
+            # (a x a').e_z / |a|^2 = a' . (-TURN a) / |a|^2
+            out.update({0: ([(0, linear(_TURN, e2))], None), 1: ([(0, e2)], None),
+                        2: ([(1, mul(recip(aa), linear(-_TURN, a)))], None)})
+        return [out[k] for k in which]
 
     def _rotation_force(self, p, moment):
         """Planar dead moment: ``delta phi = (a x delta a).e_z / |a|^2`` of the slope ``a = x_eta``."""

@@ -72,19 +72,22 @@ class SQ3D(SQElement):
         return np.array([E * A, k * G * A, k * G * A, G * s.J * s.k_t, E * s.I2, E * s.I3, E * A, E * A, G * A])
 
     @staticmethod
-    def _strains(p):
-        """``(terms, s)`` of Gamma_1..3, kappa_1..3, E_22, E_33, gamma_23; blocks 0 = r', 1 = a2', 2 = a3'."""
+    def _strains(p, which):
+        """``(terms, s)`` of Gamma_1..3, kappa_1..3, E_22, E_33, gamma_23 (those in ``which``).
+
+        Derivative blocks: 0 = r', 1 = a2', 2 = a3'.
+        """
         a2, a3 = p
-        e1, e2, e3, m, n, t = frame(a2, a3)
-        im, inn = recip(m), recip(n)
-        half = np.full(m.v.shape, 0.5)
-        return [
-            ([(0, e1)], None), ([(0, e2)], None), ([(0, e3)], None),
-            ([(2, -mul(im, e2))], None),
-            ([(2, mul(im, e1))], None),
-            ([(1, -mul(mul(m, inn), e1)), (2, mul(mul(t, inn), e1))], None),
-            ([], combine([half], [dot(a2, a2)])), ([], combine([half], [dot(a3, a3)])), ([], dot(a2, a3)),
-        ]
+        half = np.full(a2.v.shape[0], 0.5)
+        out = {6: ([], combine([half], [dot(a2, a2)])), 7: ([], combine([half], [dot(a3, a3)])),
+               8: ([], dot(a2, a3))}
+        if any(k < 6 for k in which):
+            e1, e2, e3, m, n, t = frame(a2, a3)
+            im, inn = recip(m), recip(n)
+            out.update({0: ([(0, e1)], None), 1: ([(0, e2)], None), 2: ([(0, e3)], None),
+                        3: ([(2, -mul(im, e2))], None), 4: ([(2, mul(im, e1))], None),
+                        5: ([(1, -mul(mul(m, inn), e1)), (2, mul(mul(t, inn), e1))], None)})
+        return [out[k] for k in which]
 
     def _rotation_force(self, p, moment):
         """``G^T M`` and its derivative for ``delta phi = 1/2 e_i x delta e_i`` (Sect. 2.2), frame of Eq. 7."""
