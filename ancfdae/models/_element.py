@@ -50,6 +50,10 @@ class Element(ABC):
         False only for elements whose mass matrix depends on q (BE3D).
     formulations : tuple of str
         The formulation variants the element offers.
+
+    Instance attributes ``material`` (:class:`ancfdae.materials.Material`)
+    and ``section`` (a section of :mod:`ancfdae.materials`) are required: the
+    beam reads ``rho * A`` from them for gravity.
     """
 
     name: ClassVar[str]

@@ -1,0 +1,324 @@
+"""Newton and modified Newton iteration with LU reuse (design.md Sect. 5).
+
+The chapter (Sect. 5.1) solves each load step with a classical Newton method
+and (Sect. 5.2) each time step with a *modified* Newton method that updates
+the Jacobian "only if required, i.e., if the Newton residual is not converging
+fast enough"; both stop when the max-norm of the residual over the max-norm of
+the initial residual drops below ``1e-8``. :class:`NewtonSolver` implements
+both policies on a caller-supplied residual and Jacobian:
+
+* ``jacobian="full"``: evaluate and factorise the Jacobian at every iteration.
+* ``jacobian="modified"``: keep the factorised matrix across iterations *and*
+  across calls to :meth:`NewtonSolver.solve`; refresh it when the observed
+  contraction rate ``max|r_{k+1}| / max|r_k|`` exceeds ``contraction``, and,
+  when a solve that started from a stale matrix fails, retry it once from the
+  initial guess with a fresh matrix before giving up.
+
+Imitates the simplified Newton of scipy's ``radau.solve_collocation_system``
+(LU reuse, rate estimate, early exit) with the chapter's residual test.
+"""
+from __future__ import annotations
+
+import numbers
+from dataclasses import dataclass, fields
+from typing import Callable
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ._linsolve import factorize
+
+__all__ = ["NewtonOptions", "NewtonStats", "NewtonOutcome", "NewtonSolver"]
+
+#: A rate above this with a matrix evaluated during the current attempt counts
+#: as divergence; two such iterations in a row end the attempt early.
+DIVERGENCE_RATE = 1.0
+
+
+def _real(name, value, *, low=None, high=None, low_open=False, high_open=False):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not np.isfinite(value):
+        raise ValueError(f"`{name}` must be a finite real number, got {value!r}.")
+    if low is not None and (value < low or (low_open and value == low)):
+        rule = ">" if low_open else ">="
+        raise ValueError(f"`{name}` must be {rule} {low}, got {value!r}.")
+    if high is not None and (value > high or (high_open and value == high)):
+        rule = "<" if high_open else "<="
+        raise ValueError(f"`{name}` must be {rule} {high}, got {value!r}.")
+    return float(value)
+
+
+@dataclass(frozen=True)
+class NewtonOptions:
+    """Tolerances and policy of :class:`NewtonSolver`.
+
+    Parameters
+    ----------
+    tol : float
+        Relative tolerance: converged when ``max|r_k| <= tol * max|r_0|`` with
+        ``r_0`` the residual at the initial guess of the solve (the chapter's
+        criterion, Sects. 5.1-5.2, with ``tol = 1e-8``). In ``(0, 1)``.
+    atol : float
+        Absolute floor, in the residual's own units (forces, for the models of
+        this package): also converged when ``max|r_k| <= atol``. It settles
+        solves whose initial residual is already negligible (relative
+        reduction of a round-off-sized residual is impossible). The default
+        ``1e-10`` is the default absolute tolerance of Exudyn's Newton solver;
+        it is far below any force that matters in the chapter's problems.
+        Integrators raise it to the round-off level of the model when they
+        know it. ``>= 0``.
+    max_iter : int
+        Iterations allowed per attempt (per retry as well). ``>= 1``.
+    jacobian : {"modified", "full"}
+        Refresh policy (see module docstring).
+    contraction : float
+        Modified Newton refreshes the factorisation when the observed rate
+        ``max|r_{k+1}| / max|r_k|`` exceeds this value. In ``(0, 1)``.
+    retry : bool
+        Modified Newton only: retry a failed solve once from the initial guess
+        with a fresh matrix when the failed attempt had used a stale one.
+    xtol : float
+        Also converged when the residual stagnates at round-off level: a
+        matrix evaluated in the current attempt, a residual that fell by less
+        than half, and a correction ``max|dx| <= xtol * max(1, max|x|)``. Needed on fine meshes of stiff beams, where the
+        residual's round-off floor (about ``eps * max|K| * max|x|``: 2e-3 N
+        for B1 with 128 BE2D elements) lies above ``tol * max|r_0|``; ``0``
+        disables it. ``>= 0``.
+    """
+
+    tol: float = 1e-8
+    atol: float = 1e-10
+    max_iter: int = 25
+    jacobian: str = "modified"
+    contraction: float = 0.3
+    retry: bool = True
+    xtol: float = 1e-11
+
+    def __post_init__(self):
+        _real("tol", self.tol, low=0.0, high=1.0, low_open=True, high_open=True)
+        _real("atol", self.atol, low=0.0)
+        if isinstance(self.max_iter, bool) or not isinstance(self.max_iter, numbers.Integral) or self.max_iter < 1:
+            raise ValueError(f"`max_iter` must be a positive integer, got {self.max_iter!r}.")
+        if self.jacobian not in ("modified", "full"):
+            raise ValueError(f"`jacobian` must be one of ['full', 'modified'], got {self.jacobian!r}.")
+        _real("contraction", self.contraction, low=0.0, high=1.0, low_open=True, high_open=True)
+        _real("xtol", self.xtol, low=0.0)
+        if not isinstance(self.retry, bool):
+            raise ValueError(f"`retry` must be True or False, got {self.retry!r}.")
+
+
+@dataclass
+class NewtonStats:
+    """Work counters; ``a + b`` adds them field by field."""
+
+    iterations: int = 0
+    residual_evals: int = 0
+    jacobian_evals: int = 0
+    factorizations: int = 0
+    solves: int = 0
+    failed_solves: int = 0
+    retries: int = 0
+
+    def __add__(self, other: "NewtonStats") -> "NewtonStats":
+        if not isinstance(other, NewtonStats):
+            return NotImplemented
+        return NewtonStats(**{f.name: getattr(self, f.name) + getattr(other, f.name) for f in fields(self)})
+
+    def as_dict(self) -> dict:
+        """The counters as a plain dict."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+
+@dataclass(frozen=True)
+class NewtonOutcome:
+    """Result of one :meth:`NewtonSolver.solve`.
+
+    Attributes
+    ----------
+    x : ndarray
+        Last iterate (the solution when ``converged``).
+    converged : bool
+    iterations : int
+        Iterations of this solve, retries included.
+    residual_norm : float
+        ``max|r|`` at ``x``.
+    message : str
+    """
+
+    x: np.ndarray
+    converged: bool
+    iterations: int
+    residual_norm: float
+    message: str
+
+
+class _Factor:
+    """LU factorisation (banded LAPACK, dense LAPACK or SuperLU; see ``_linsolve``)."""
+
+    def __init__(self, matrix):
+        self._lu = factorize(matrix)
+
+    def solve(self, rhs):
+        return self._lu.solve(rhs)
+
+
+class NewtonSolver:
+    """Solve ``residual(x) = 0`` by (modified) Newton iteration.
+
+    Parameters
+    ----------
+    options : NewtonOptions, optional
+        Defaults to ``NewtonOptions()``.
+
+    Attributes
+    ----------
+    stats : NewtonStats
+        Cumulative counters over every call.
+
+    Notes
+    -----
+    The solver keeps at most one factorisation. The caller must call
+    :meth:`invalidate` whenever the meaning of the Jacobian changes in a way
+    the contraction test cannot be trusted to detect (new step size, new
+    iteration-matrix coefficients, different equations).
+    """
+
+    def __init__(self, options: NewtonOptions | None = None):
+        if options is None:
+            options = NewtonOptions()
+        if not isinstance(options, NewtonOptions):
+            raise TypeError(f"`options` must be a NewtonOptions, got {type(options).__name__}.")
+        self.options = options
+        self.stats = NewtonStats()
+        self._lu: _Factor | None = None
+
+    def invalidate(self) -> None:
+        """Drop the cached factorisation; the next iteration refactorises."""
+        self._lu = None
+
+    @property
+    def has_factorization(self) -> bool:
+        """True while a factorisation is cached."""
+        return self._lu is not None
+
+    def _refresh(self, jacobian, x):
+        J = jacobian(x)
+        self.stats.jacobian_evals += 1
+        try:
+            self._lu = _Factor(J)
+        except RuntimeError as exc:  # SuperLU: "Factor is exactly singular"
+            self._lu = None
+            return f"factorisation failed: {exc}"
+        self.stats.factorizations += 1
+        return None
+
+    def _eval(self, residual, x):
+        self.stats.residual_evals += 1
+        r = np.asarray(residual(x), dtype=float)
+        if r.shape != x.shape:
+            raise ValueError(f"`residual` must return shape {x.shape}, got {r.shape}.")
+        return r
+
+    def solve(
+        self,
+        residual: Callable[[np.ndarray], np.ndarray],
+        jacobian: Callable[[np.ndarray], object],
+        x0,
+    ) -> NewtonOutcome:
+        """Iterate from ``x0`` until the residual test passes.
+
+        Parameters
+        ----------
+        residual : callable
+            ``residual(x) -> ndarray`` of the shape of ``x``.
+        jacobian : callable
+            ``jacobian(x) -> d residual / dx`` as a scipy sparse matrix or a
+            dense 2-D array.
+        x0 : array_like
+            Initial guess (not modified).
+
+        Returns
+        -------
+        NewtonOutcome
+            Never raises on non-convergence; exceptions raised by the
+            callbacks propagate.
+        """
+        x0 = np.array(x0, dtype=float, copy=True).ravel()
+        self.stats.solves += 1
+        r = self._eval(residual, x0)
+        if not np.all(np.isfinite(r)):
+            self.stats.failed_solves += 1
+            return NewtonOutcome(x0, False, 0, float("nan"), "residual at the initial guess is not finite")
+        outcome = self._attempt(residual, jacobian, x0, r)
+        if (not outcome[0].converged and outcome[1] and self.options.jacobian == "modified"
+                and self.options.retry):
+            # The failed attempt started from a matrix of an earlier solve:
+            # retry once from the initial guess with a fresh one.
+            self.stats.retries += 1
+            self.invalidate()
+            first = outcome[0]
+            retry, _ = self._attempt(residual, jacobian, x0, r)
+            outcome = (NewtonOutcome(retry.x, retry.converged, first.iterations + retry.iterations,
+                                     retry.residual_norm,
+                                     retry.message if retry.converged else
+                                     f"{retry.message} (after a retry with a fresh Jacobian; "
+                                     f"first attempt: {first.message})"), False)
+        if not outcome[0].converged:
+            self.stats.failed_solves += 1
+        return outcome[0]
+
+    def _attempt(self, residual, jacobian, x0, r):
+        """One Newton attempt; returns (outcome, started_with_stale_matrix)."""
+        opts = self.options
+        full = opts.jacobian == "full"
+        stale = self._lu is not None and not full
+        x = x0.copy()
+        err0 = err = float(np.max(np.abs(r))) if r.size else 0.0
+        threshold = max(opts.tol * err0, opts.atol)
+        if err <= threshold:
+            return NewtonOutcome(x, True, 0, err, "converged at the initial guess"), stale
+        fresh = False  # the cached matrix was evaluated during this attempt
+        diverging = 0
+        for k in range(1, opts.max_iter + 1):
+            if full or self._lu is None:
+                msg = self._refresh(jacobian, x)
+                if msg is not None:
+                    return NewtonOutcome(x, False, k - 1, err, msg), stale
+                fresh = True
+            dx = self._lu.solve(-r)
+            self.stats.iterations += 1
+            if not np.all(np.isfinite(dx)):
+                return NewtonOutcome(x, False, k, err, "Newton correction is not finite "
+                                     "(singular iteration matrix?)"), stale
+            x = x + dx
+            r = self._eval(residual, x)
+            if not np.all(np.isfinite(r)):
+                return NewtonOutcome(x, False, k, float("nan"),
+                                     f"residual became non-finite at iteration {k}"), stale
+            err_new = float(np.max(np.abs(r)))
+            if err_new <= threshold:
+                return NewtonOutcome(x, True, k, err_new, f"converged in {k} iterations"), stale
+            # Round-off stagnation: a fresh matrix, a correction at round-off
+            # level and a residual that no longer falls -- the attainable accuracy.
+            if (fresh and err_new > 0.5 * err
+                    and np.max(np.abs(dx)) <= opts.xtol * max(1.0, float(np.max(np.abs(x))))):
+                return NewtonOutcome(x, True, k, err_new, f"converged in {k} iterations "
+                                     f"(correction at round-off level, max|r| = {err_new:.3e})"), stale
+            rate = err_new / err if err > 0 else np.inf
+            err = err_new
+            if rate > opts.contraction:
+                if fresh and rate >= DIVERGENCE_RATE:
+                    diverging += 1
+                    if diverging >= 2:
+                        return NewtonOutcome(x, False, k, err, f"diverging (rate {rate:.3g} at "
+                                             f"iteration {k} with a fresh Jacobian)"), stale
+                else:
+                    diverging = 0
+                if not full:
+                    self._lu = None  # refresh at the current iterate
+            else:
+                diverging = 0
+        return NewtonOutcome(x, False, opts.max_iter, err,
+                             f"not converged in {opts.max_iter} iterations "
+                             f"(max|r| = {err:.3e}, target {threshold:.3e})"), stale

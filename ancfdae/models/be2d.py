@@ -1,0 +1,249 @@
+"""BE2D: the planar Bernoulli-Euler ANCF beam element (chapter Sects. 3.1-3.3).
+
+Two nodes with coordinates ``(x, y, x', y')`` -- position and axial slope --
+and the cubic Hermite interpolation of chapter Eq. 60, 8 DOF per element.
+
+Both formulations are written as an energy density in the two invariants of
+the axis at a quadrature point, ``g = r'.r'`` and ``c = (r' x r'').e_z``:
+``|r'| = sqrt(g)`` and the material curvature ``K = c / g`` (Eq. 70). Since
+``g`` and ``c`` are quadratic forms in the element coordinates, their
+Hessians are constant and are precomputed; the force is
+``W_g dg + W_c dc`` and the tangent
+``W_gg dg dg^T + W_gc (dg dc^T + dc dg^T) + W_cc dc dc^T + W_g d2g + W_c d2c``,
+exact, for all elements and points in a few ``einsum`` calls.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .._validate import choice, positive_int
+from ..materials import Material
+from ._element import Element
+from ._quadrature import gauss
+from ._shapes import hermite
+
+__all__ = ["BE2D"]
+
+# (r' x r'').e_z = r'^T P r''
+_P = np.array([[0.0, 1.0], [-1.0, 0.0]])
+
+
+def _expand2(N: np.ndarray) -> np.ndarray:
+    """Scalar shape functions (..., 4) -> interpolation matrices (..., 2, 8), dof order (x, y) per function."""
+    out = np.zeros(N.shape[:-1] + (2, 8))
+    out[..., 0, 0::2] = N
+    out[..., 1, 1::2] = N
+    return out
+
+
+class BE2D(Element):
+    """Planar Bernoulli-Euler ANCF beam element (chapter Sects. 3.1-3.3).
+
+    Parameters
+    ----------
+    material : Material
+    section : RectangularSection or CircularSection
+        Uses ``A``, ``I3`` (in-plane bending) and, for the continuum
+        formulation, ``I4``.
+    formulation : {"structural", "continuum"}
+        ``"structural"``: axial strain ``eps0 = |r'| - 1`` and curvature ``K``
+        (Eq. 78) with ``U = int EA/2 (eps0 - eps0_ref)^2 + EI/2 (K - K_ref)^2
+        dxi`` (Eqs. 82-83); the reference values make a pre-curved or
+        pre-stretched undeformed beam stress-free.
+        ``"continuum"``: St. Venant-Kirchhoff on the Green strain
+        ``E11 = ((|r'| - eta K)^2 - 1)/2`` (Eq. 74) integrated exactly over
+        the section, ``U = int E/2 [A a^2 + I (3g-1)/(2g^2) c^2 + I4 c^4/(4 g^4)]
+        dxi`` with ``a = (g-1)/2`` -- the energy whose variation is Eqs. 84-88
+        (with the factor EA of Eq. 84 restored); straight reference only.
+    axial_points, bending_points : int
+        Gauss points for the axial and the bending (curvature) terms. The
+        defaults 5 and 3 (integration orders 9 and 5, as recommended at the
+        end of Sect. 3.5) reproduce the chapter's Table 2.
+    """
+
+    name = "BE2D"
+    dim = 2
+    node_params = (-1.0, 1.0)
+    node_coordinates = ("x", "y", "x'", "y'")
+    formulations = ("structural", "continuum")
+
+    def __init__(self, material: Material, section, formulation: str = "structural",
+                 axial_points: int = 5, bending_points: int = 3):
+        if not isinstance(material, Material):
+            raise TypeError(f"`material` must be a Material, got {material!r}.")
+        for attr in ("A", "I3", "I4"):
+            if not hasattr(section, attr):
+                raise TypeError(f"`section` must provide {attr} (e.g. RectangularSection), got {section!r}.")
+        self.material = material
+        self.section = section
+        self.formulation = choice("formulation", formulation, self.formulations)
+        self.axial_points = positive_int("axial_points", axial_points)
+        self.bending_points = positive_int("bending_points", bending_points)
+
+    def __repr__(self):
+        return (f"BE2D(formulation={self.formulation!r}, axial_points={self.axial_points}, "
+                f"bending_points={self.bending_points})")
+
+    # -- mesh -----------------------------------------------------------
+    def reference_coordinates(self, points, frames):
+        return np.concatenate([points, frames[:, :, 0]], axis=1)
+
+    def support_coordinates(self, kind, frame):
+        if kind == "pin":
+            return ("x", "y")
+        # Clamp: fix the transverse slope only, so the axial strain at the
+        # clamp stays free (benchmarks.md B1); possible when the axis is
+        # aligned with e_x or e_y, otherwise both slope coordinates are fixed.
+        t = frame[:, 0]
+        if abs(t[1]) < 1e-12:
+            return ("x", "y", "y'")
+        if abs(t[0]) < 1e-12:
+            return ("x", "y", "x'")
+        return ("x", "y", "x'", "y'")
+
+    def prepare(self, q_ref, lengths):
+        # One concatenated point set: the axial rule's points first, then the
+        # bending rule's; masks select which density acts where. Arrays are
+        # stored points-last ("structure of arrays", (..., n_el, n_pts)) so that
+        # every elementwise operation runs over all elements x points at once.
+        sa, wa = gauss(self.axial_points)
+        sb, wb = gauss(self.bending_points)
+        s = np.concatenate([sa, sb])
+        w = np.concatenate([wa, wb])
+        _, dN, ddN = hermite(s, lengths)                         # (n_el, n_pts, 4)
+        n_el, n_pts = dN.shape[:2]
+        is_a = np.zeros(n_pts, dtype=bool)
+        is_a[:sa.size] = True
+        geom = {"L": lengths, "w": w[None, :] * lengths[:, None] / 2.0,
+                "dN_e": dN, "ddN_e": ddN,                                   # (n_el, n_pts, 4): for r', r''
+                "dN": np.ascontiguousarray(dN.transpose(2, 0, 1))[:, None],  # (4, 1, n_el, n_pts)
+                "ddN": np.ascontiguousarray(ddN.transpose(2, 0, 1))[:, None],
+                "is_a": is_a, "is_b": ~is_a}
+        # Constant Hessians of g = r'.r' and c = (r' x r'').e_z, stacked as (n_el, 2*n_pts, 64).
+        I2 = np.eye(2)
+        d2g = 2.0 * np.einsum("epk,epl,ab->epkalb", dN, dN, I2)
+        d2c = np.einsum("epk,epl,ab->epkalb", dN, ddN, _P) + np.einsum("epk,epl,ab->epkalb", ddN, dN, _P.T)
+        geom["d2"] = np.stack([d2g.reshape(n_el, n_pts, 64), d2c.reshape(n_el, n_pts, 64)], axis=1
+                              ).reshape(n_el, 2 * n_pts, 64)
+        g, c = self._invariants(geom, q_ref, derivatives=False)
+        geom["eps_ref"] = np.sqrt(g) - 1.0
+        geom["K_ref"] = c / g
+        if self.formulation == "continuum":
+            bent = max(np.abs(geom["eps_ref"]).max(), np.abs(geom["K_ref"]).max() * lengths.max())
+            if bent > 1e-10:
+                raise ValueError("formulation='continuum' needs a straight, unstretched reference configuration; "
+                                 f"the given nodes have |eps_ref|, |K_ref| L up to {bent:.3g}.")
+        sm, wm = gauss(4)   # cubic x cubic: exact with 4 points
+        N, _, _ = hermite(sm, lengths)
+        m = np.einsum("ep,epi,epj->eij", wm[None, :] * lengths[:, None] / 2, N, N)
+        rhoA = self.material.rho * self.section.A
+        geom["M"] = rhoA * np.einsum("eij,kl->eikjl", m, I2).reshape(-1, 8, 8)
+        return geom
+
+    # -- kernels --------------------------------------------------------
+    @staticmethod
+    def _invariants(geom, q, derivatives=True):
+        """g, c at every point, shape (n_el, n_pts), and if asked dg, dc of shape (4, 2, n_el, n_pts)."""
+        Q = q.reshape(q.shape[0], 4, 2)
+        r1 = np.ascontiguousarray((geom["dN_e"] @ Q).transpose(2, 0, 1))      # (2, n_el, n_pts)
+        r2 = np.ascontiguousarray((geom["ddN_e"] @ Q).transpose(2, 0, 1))
+        g = r1[0] * r1[0] + r1[1] * r1[1]
+        c = r1[0] * r2[1] - r1[1] * r2[0]
+        if not derivatives:
+            return g, c
+        dN, ddN = geom["dN"], geom["ddN"]
+        dg = dN * (2.0 * r1)
+        # dc = Sx^T P r'' + Sxx^T P^T r', with P r'' = (r''_y, -r''_x), P^T r' = (-r'_y, r'_x)
+        r2[0] *= -1.0
+        r1[1] *= -1.0
+        dc = dN * r2[::-1] + ddN * r1[::-1]
+        return g, c, dg, dc
+
+    def _densities(self, g, c, geom, hessian=True):
+        """Energy density derivatives in (g, c): (W, Wg, Wc[, Wgg, Wgc, Wcc]), each (n_el, n_pts).
+
+        Axial terms act at the axial rule's points, bending terms at the
+        bending rule's points.
+        """
+        E, sec = self.material.E, self.section
+        EA, EI = E * sec.A, E * sec.I3
+        a_pts, b_pts = geom["is_a"], geom["is_b"]
+        if self.formulation == "structural":
+            a = 1.0 + geom["eps_ref"]
+            rg = np.sqrt(g)
+            Kr = geom["K_ref"]
+            K = c / g
+            dK = K - Kr
+            W = np.where(a_pts, 0.5 * EA * (rg - a) ** 2, 0.5 * EI * dK**2)
+            Wg = np.where(a_pts, EA * (0.5 - a / (2 * rg)), -EI * dK * K / g)
+            Wc = (EI * b_pts) * dK / g
+            if not hessian:
+                return W, Wg, Wc
+            Wgg = np.where(a_pts, EA * a / (4 * g * rg), EI * (3 * K**2 - 2 * Kr * K) / g**2)
+            Wgc = (-EI * b_pts) * (2 * K - Kr) / g**2
+            Wcc = (EI * b_pts) / g**2
+            return W, Wg, Wc, Wgg, Wgc, Wcc
+        a = 0.5 * (g - 1.0)
+        I, I4 = sec.I3, sec.I4
+        ig = 1.0 / g
+        phi = (1.5 - 0.5 * ig) * ig
+        phi1 = (-1.5 + ig) * ig**2
+        psi, psi1 = 0.25 * ig**4, -ig**5
+        c2 = c * c
+        W = np.where(a_pts, 0.5 * EA * a**2, 0.5 * E * (I * c2 * phi + I4 * c2 * c2 * psi))
+        Wg = np.where(a_pts, 0.5 * EA * a, 0.5 * E * (I * c2 * phi1 + I4 * c2 * c2 * psi1))
+        Wc = (E * b_pts) * (I * c * phi + 2 * I4 * c2 * c * psi)
+        if not hessian:
+            return W, Wg, Wc
+        phi2 = (3.0 - 3.0 * ig) * ig**3
+        psi2 = 5.0 * ig**6
+        Wgg = np.where(a_pts, 0.25 * EA, 0.5 * E * (I * c2 * phi2 + I4 * c2 * c2 * psi2))
+        Wgc = (E * b_pts) * (I * c * phi1 + 2 * I4 * c2 * c * psi1)
+        Wcc = (E * b_pts) * (I * phi + 6 * I4 * c2 * psi)
+        return W, Wg, Wc, Wgg, Wgc, Wcc
+
+    def mass_matrix(self, geom):
+        return geom["M"]
+
+    def strain_energy(self, geom, q):
+        g, c = self._invariants(geom, q, derivatives=False)
+        return np.sum(geom["w"] * self._densities(g, c, geom, hessian=False)[0], axis=1)
+
+    def internal_forces(self, geom, q, tangent=True):
+        w = geom["w"]
+        g, c, dg, dc = self._invariants(geom, q)
+        D = self._densities(g, c, geom, hessian=tangent)
+        n_el, n_pts = g.shape
+        # f_i = sum_p w (Wg dg_i + Wc dc_i)
+        wg, wc = w * D[1], w * D[2]
+        f = (np.sum(dg * wg + dc * wc, axis=-1)).reshape(8, n_el).T
+        if not tangent:
+            return f, None
+        Wgg, Wgc, Wcc = w * D[3], w * D[4], w * D[5]
+        Bg = dg * Wgg + dc * Wgc                         # H A, row g
+        Bc = dg * Wgc + dc * Wcc                         # H A, row c
+        A = np.concatenate([dg, dc], axis=-1).reshape(8, n_el, 2 * n_pts).transpose(1, 0, 2)
+        B = np.concatenate([Bg, Bc], axis=-1).reshape(8, n_el, 2 * n_pts).transpose(1, 2, 0)
+        first = np.stack([wg, wc], axis=1).reshape(n_el, 1, 2 * n_pts)
+        K = A @ B + (first @ geom["d2"]).reshape(n_el, 8, 8)
+        return f, K
+
+    def shape_matrix(self, s, lengths):
+        N, _, _ = hermite(np.asarray(s, dtype=float), lengths)
+        return _expand2(N)
+
+    def moment_load(self, geom, q, s, moment, element, tangent=True):
+        """Dead moment ``M_z`` at ``s``: ``delta phi = (r' x delta r').e_z / |r'|^2``."""
+        L = geom["L"][[element]]
+        _, dN, _ = hermite(np.array([s]), L)
+        Sx = _expand2(dN)[0, 0]                        # (2, 8)
+        r1 = Sx @ q
+        g = r1 @ r1
+        h = Sx.T @ (_P.T @ r1)                         # d(r' x r'')/d... : Sx^T P^T r'
+        Mz = float(moment[2])
+        f = Mz * h / g
+        if not tangent:
+            return f, None
+        dh = Sx.T @ _P.T @ Sx
+        dg = 2.0 * Sx.T @ r1
+        return f, Mz * (dh / g - np.outer(h, dg) / g**2)

@@ -1,0 +1,112 @@
+"""Static equilibrium by Newton's method with uniform load steps (chapter Sect. 5.1)."""
+from __future__ import annotations
+
+import time as _time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ._validate import positive_int
+from .integrators._newton import NewtonOptions, NewtonSolver, NewtonStats
+from .problem import accept_step
+
+__all__ = ["solve_static", "StaticResult"]
+
+
+@dataclass
+class StaticResult:
+    """Outcome of :func:`solve_static`.
+
+    Attributes
+    ----------
+    q : ndarray
+        Coordinates of the last converged load step (the solution when
+        ``status == "converged"``; never an unconverged iterate).
+    status : {"converged", "failed"}
+    message : str
+        Says which load step failed and with which residual, if one did.
+    iterations : int
+        Newton iterations over all load steps.
+    steps : list of dict
+        Per load step: ``load_factor``, ``iterations``, ``residual``, ``converged``, ``q``.
+    stats : NewtonStats
+    cpu_time : float
+        Process time of the solve in seconds.
+    """
+
+    q: np.ndarray
+    status: str
+    message: str
+    iterations: int
+    steps: list = field(default_factory=list)
+    stats: NewtonStats = field(default_factory=NewtonStats)
+    cpu_time: float = 0.0
+
+    @property
+    def success(self) -> bool:
+        return self.status == "converged"
+
+
+def solve_static(model, load_steps: int = 10, *, t: float = 0.0, q0=None, tol: float = 1e-8,
+                 atol: float = 1e-10, max_iter: int = 25, jacobian: str = "full") -> StaticResult:
+    """Solve ``r(t, q, 0, 0) = 0`` with the loads applied in uniform steps.
+
+    Load step ``i`` solves for the load factor ``lambda_i = i / load_steps``,
+    starting from the solution of step ``i - 1`` (chapter Sect. 5.1: ten
+    uniform steps ``F_i = i/10 F``, full Newton, converged when
+    ``max|r| / max|r_first| < 1e-8``).
+
+    Parameters
+    ----------
+    model : Model
+        Must have a ``load_factor`` attribute (as :class:`ancfdae.models.Beam`
+        does) when ``load_steps > 1``; the attribute is restored afterwards.
+    load_steps : int
+        Number of uniform load steps (>= 1).
+    t : float
+        Time at which the time functions of the loads are evaluated.
+    q0 : array_like, optional
+        Initial guess; the model's initial state by default.
+    tol, atol, max_iter, jacobian
+        Newton options, see :class:`ancfdae.integrators._newton.NewtonOptions`
+        (``jacobian="full"`` is the chapter's classical Newton).
+
+    Returns
+    -------
+    StaticResult
+        A step that does not converge ends the solve with ``status="failed"``
+        and a message naming the load step and its residual; ``q`` is then the
+        last converged step's solution.
+    """
+    load_steps = positive_int("load_steps", load_steps)
+    if load_steps > 1 and not hasattr(model, "load_factor"):
+        raise ValueError("`model` must have a `load_factor` attribute for load stepping; "
+                         f"use load_steps=1 with {type(model).__name__}.")
+    solver = NewtonSolver(NewtonOptions(tol=tol, atol=atol, max_iter=max_iter, jacobian=jacobian))
+    q = model.initial_state()[0].copy() if q0 is None else np.array(q0, dtype=float)
+    if q.shape != (model.n_dof,):
+        raise ValueError(f"`q0` must have shape ({model.n_dof},), got {q.shape}.")
+    z = np.zeros(model.n_dof)
+    saved = getattr(model, "load_factor", None)
+    steps, status, message = [], "converged", f"converged in {load_steps} load steps"
+    start = _time.process_time()
+    try:
+        for i in range(1, load_steps + 1):
+            lam = i / load_steps
+            if saved is not None:
+                model.load_factor = saved * lam
+            out = solver.solve(lambda x: model.residual(t, x, z, z), lambda x: model.jacobian(t, x, z, z).K, q)
+            steps.append({"load_factor": lam, "iterations": out.iterations, "residual": out.residual_norm,
+                          "converged": out.converged, "q": out.x if out.converged else q.copy()})
+            if not out.converged:
+                status = "failed"
+                message = (f"load step {i} of {load_steps} (load factor {lam:g}) did not converge: "
+                           f"{out.message}; max|r| = {out.residual_norm:.3e}")
+                break
+            q, _ = accept_step(model, t, out.x, z)
+    finally:
+        if saved is not None:
+            model.load_factor = saved
+    return StaticResult(q=q, status=status, message=message,
+                        iterations=sum(s["iterations"] for s in steps), steps=steps,
+                        stats=solver.stats, cpu_time=_time.process_time() - start)
