@@ -122,7 +122,8 @@ def update_directors(geom, Q, V, variant):
         return Q, V
     D = geom["directors"]
     a = Q[:, 3:6]
-    F, n = frames(a, Q[:, 6], D)
+    with np.errstate(invalid="ignore", divide="ignore"):   # a singular node is reported below
+        F, n = frames(a, Q[:, 6], D)
     bad = np.flatnonzero(~(n > _SINGULAR))
     if bad.size:
         raise FloatingPointError(

@@ -38,14 +38,21 @@ def hermite_operator(N: np.ndarray, dof_map: np.ndarray, n_edof: int) -> np.ndar
 class PointRule:
     """A Gauss rule on all elements: points, weights ``w L / 2`` and Hermite operators.
 
+    ``n_points`` is the number of Gauss points, or an array of normalised
+    coordinates (then the weights are zero: for evaluating fields there).
+
     Attributes
     ----------
     s : (n_pts,) normalised coordinates; ``wdx`` : (n_el, n_pts) weights of ``dxi``;
     S, Ba, Bb : (n_el, n_pts, 3, n_edof) operators giving ``r``, ``r'`` and ``r''``.
     """
 
-    def __init__(self, n_points: int, lengths: np.ndarray, dof_map: np.ndarray, n_edof: int):
-        self.s, w = gauss(n_points)
+    def __init__(self, n_points, lengths: np.ndarray, dof_map: np.ndarray, n_edof: int):
+        if np.ndim(n_points) == 0:
+            self.s, w = gauss(n_points)
+        else:   # explicit points (for evaluating fields at given s), zero weights
+            self.s = np.asarray(n_points, dtype=float)
+            w = np.zeros_like(self.s)
         self.wdx = w[None, :] * lengths[:, None] / 2.0
         N, dN, ddN = hermite(self.s, lengths)
         self.S = hermite_operator(N, dof_map, n_edof)

@@ -178,14 +178,31 @@ class BE3D(Element):
         return np.eye(3)[np.argmin(np.abs(slopes), axis=1)]
 
     # -- kernels ----------------------------------------------------------
-    def _curvatures(self, geom, q, second):
-        rule = geom["bend"]
+    @staticmethod
+    def _local(geom, q, rule):
+        """Slope, its derivative, angle, its derivative, director and its derivative at a rule's points."""
         d, dp = director_field(geom["directors"], rule)
         a = np.einsum("epin,en->epi", rule.Ba, q)
         b = np.einsum("epin,en->epi", rule.Bb, q)
         th = np.einsum("epn,en->ep", rule.Nt, q)
         dth = np.einsum("epn,en->ep", rule.dNt, q)
-        return curvatures(a, b, th, dth, d, np.broadcast_to(dp, d.shape), second=bool(second))
+        return a, b, th, dth, d, np.broadcast_to(dp, d.shape)
+
+    def _curvatures(self, geom, q, second, rule=None):
+        return curvatures(*self._local(geom, q, geom["bend"] if rule is None else rule), second=bool(second))
+
+    def curvature(self, geom, q, s):
+        """Twist and curvatures ``(k1, k2, k3)`` per xi at normalised coordinates ``s``, shape (n_el, n_pts, 3)."""
+        rule = self._rule(np.atleast_1d(np.asarray(s, dtype=float)), geom["L"])
+        return np.stack([k.v for k in self._curvatures(geom, q, False, rule)], axis=-1)
+
+    def spin(self, geom, q, v, s):
+        """Angular velocity of the cross-section about the axis, ``omega . e1``, shape (n_el, n_pts)."""
+        rule = self._rule(np.atleast_1d(np.asarray(s, dtype=float)), geom["L"])
+        a = np.einsum("epin,en->epi", rule.Ba, q)
+        d, _ = director_field(geom["directors"], rule)
+        g = np.stack([j.v for j in spin_coefficients(a, d, False)], axis=-1)
+        return np.einsum("epn,en->ep", rule.Nt, v) + np.einsum("epi,epin,en->ep", g, rule.Ba, v)
 
     def mass_matrix(self, geom):
         """Constant part ``rho A int S^T S dxi`` (zero rows and columns for theta)."""
@@ -220,14 +237,8 @@ class BE3D(Element):
 
     def frames(self, geom, q, s):
         """Cross-section frames at normalised coordinates ``s``, shape (n_el, n_pts, 3, 3), columns e1, e2, e3."""
-        s = np.atleast_1d(np.asarray(s, dtype=float))
-        L = geom["L"]
-        _, dN, _ = hermite(s, L)
-        N, _ = linear(s, L)
-        a = np.einsum("epin,en->epi", hermite_operator(dN, _DOF, _NDOF), q)
-        th = np.einsum("epk,ek->ep", N, q[:, _THETA])
-        D = geom["directors"]
-        d = N[..., 0, None] * D[:-1, None, :] + N[..., 1, None] * D[1:, None, :]
+        rule = self._rule(np.atleast_1d(np.asarray(s, dtype=float)), geom["L"])
+        a, _, th, _, d, _ = self._local(geom, q, rule)
         F, _ = frames(a, th, d)
         return F
 
