@@ -321,3 +321,14 @@ def test_semi_discrete_equations_conserve_energy():
     ep, em = beam.energy(0.0, q + h * v, v + h * a), beam.energy(0.0, q - h * v, v - h * a)
     dT, dU = (ep.kinetic - em.kinetic) / (2 * h), (ep.strain - em.strain) / (2 * h)
     assert abs(dT) > 100.0 and abs(dT + dU) < 1e-8 * abs(dT)
+
+
+def test_cantilever_study_has_the_be3d_and_cable3d_rows():
+    from ancfdae.studies import cantilever
+    res = cantilever.run(elements=["BE3D", "Cable3D"], n_elements=(2, 4), plots=False, progress=False)
+    rows = {(r["element"], r["n_elements"]): r for r in res["rows"]}
+    for n in (2, 4):
+        dof, err, _, its = cantilever.TABLE2["BE3D"][n]
+        assert rows["BE3D", n]["dof"] == dof and rows["BE3D", n]["iterations"] == its
+        assert rows["BE3D", n]["error"] == pytest.approx(err, rel=5e-3)
+        assert rows["Cable3D", n]["error"] == pytest.approx(rows["BE3D", n]["error"], rel=1e-9)

@@ -32,12 +32,23 @@ import numpy as np
 
 from ._jet import Jet
 
-__all__ = ["curvatures", "spin_coefficients", "frames", "director_field", "EPS"]
+__all__ = ["curvatures", "spin_coefficients", "frames", "director_field", "cross", "EPS"]
 
 # Levi-Civita symbol: (u x v)_i = EPS[i, j, k] u_j v_k
 EPS = np.zeros((3, 3, 3))
 EPS[0, 1, 2] = EPS[1, 2, 0] = EPS[2, 0, 1] = 1.0
 EPS[0, 2, 1] = EPS[2, 1, 0] = EPS[1, 0, 2] = -1.0
+
+
+def cross(u, v):
+    """``u x v`` over the last axis (np.cross costs several times more on small batches)."""
+    u0, u1, u2 = u[..., 0], u[..., 1], u[..., 2]
+    v0, v1, v2 = v[..., 0], v[..., 1], v[..., 2]
+    return np.stack([u1 * v2 - u2 * v1, u2 * v0 - u0 * v2, u0 * v1 - u1 * v0], axis=-1)
+
+
+def _dot(u, v):
+    return u[..., 0] * v[..., 0] + u[..., 1] * v[..., 1] + u[..., 2] * v[..., 2]
 
 
 def _jet(v, n, second, grads, hess=()):
@@ -57,10 +68,10 @@ def _invariants(a, b, d, dp, n, second, with_b=True):
     """Polynomial invariants as jets over ``(a[, b, theta, theta'])`` (variables a: 0:3, b: 3:6)."""
     A, B = slice(0, 3), slice(3, 6)
     I = np.eye(3)
-    dot = lambda u, v: np.einsum("...i,...i", u, v)   # noqa: E731
+    dot = _dot
     dd = dot(d, d)
     ad = dot(a, d)
-    m = np.cross(d, a)
+    m = cross(d, a)
     out = {
         "p": _jet(dot(a, a), n, second, [(A, 2.0 * a)], [((A, A), 2.0 * I)]),
         "ad": _jet(ad, n, second, [(A, d)]),
@@ -72,9 +83,9 @@ def _invariants(a, b, d, dp, n, second, with_b=True):
         Hab = np.einsum("ijk,...k->...ij", EPS, d)
         out["ab"] = _jet(dot(a, b), n, second, [(A, b), (B, a)], [((A, B), I), ((B, A), I)])
         out["bd"] = _jet(dot(b, d), n, second, [(B, d)])
-        out["t"] = _jet(dot(b, m), n, second, [(A, np.cross(b, d)), (B, m)],
+        out["t"] = _jet(dot(b, m), n, second, [(A, cross(b, d)), (B, m)],
                         [((A, B), Hab), ((B, A), np.swapaxes(Hab, -1, -2))])
-        out["tp"] = _jet(dot(dp, m), n, second, [(A, np.cross(dp, d))])
+        out["tp"] = _jet(dot(dp, m), n, second, [(A, cross(dp, d))])
     return out
 
 
@@ -109,7 +120,7 @@ def spin_coefficients(a, d, second=True):
     inv = _invariants(a, None, d, None, 3, second, with_b=False)
     p, ad, m2 = inv["p"], inv["ad"], inv["m2"]
     coef = ad / (p.sqrt() * m2)
-    m = np.cross(d, a)
+    m = cross(d, a)
     # d(d x a)_j / da_k = EPS[j, l, k] d_l
     dm = np.einsum("jlk,...l->...jk", EPS, d)
     zero = np.zeros(a.shape[:-1] + (3, 3)) if second else None
@@ -123,10 +134,10 @@ def frames(a, theta, d):
     director and axis (the projection of Eq. 99 is singular at ``n = 0``).
     """
     e1 = a / np.linalg.norm(a, axis=-1, keepdims=True)
-    u = np.cross(d, e1)
+    u = cross(d, e1)
     nu = np.linalg.norm(u, axis=-1, keepdims=True)
     e20 = u / nu
-    e30 = np.cross(e1, e20)
+    e30 = cross(e1, e20)
     c, s = np.cos(theta)[..., None], np.sin(theta)[..., None]
     e2 = c * e20 + s * e30
     e3 = c * e30 - s * e20
