@@ -332,3 +332,20 @@ def test_cantilever_study_has_the_be3d_and_cable3d_rows():
         assert rows["BE3D", n]["dof"] == dof and rows["BE3D", n]["iterations"] == its
         assert rows["BE3D", n]["error"] == pytest.approx(err, rel=5e-3)
         assert rows["Cable3D", n]["error"] == pytest.approx(rows["BE3D", n]["error"], rel=1e-9)
+
+
+def test_residual_path_equals_the_jets():
+    """The written-out chain rule of the residual path equals the jets' values and gradients."""
+    from ancfdae.models._be3d_kinematics import curvature_energy, curvatures, spin_gradient
+    rng = np.random.default_rng(9)
+    a, b, d, dp, k_ref = rng.standard_normal((5, 4, 3, 3))
+    th, dth = rng.standard_normal((2, 4, 3))
+    D = np.array([1.3, 0.7, 2.1])
+    k = curvatures(a, b, th, dth, d, dp, second=False)
+    W, grad = curvature_energy(a, b, th, dth, d, dp, k_ref, D)
+    assert np.allclose(W, 0.5 * sum(D[i] * (k[i].v - k_ref[..., i]) ** 2 for i in range(3)), rtol=1e-13)
+    assert rel_err(grad, sum(D[i] * (k[i].v - k_ref[..., i])[..., None] * k[i].g for i in range(3))) < 1e-13
+    gj = spin_coefficients(a, d, False)
+    g, G = spin_gradient(a, d)
+    assert rel_err(g, np.stack([x.v for x in gj], -1)) < 1e-14
+    assert rel_err(G, np.stack([x.g for x in gj], -2)) < 1e-14

@@ -52,7 +52,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._be3d_kinematics import director_field, frames, spin_coefficients
+from ._be3d_kinematics import director_field, frames, spin_coefficients, spin_gradient
 
 __all__ = ["rotary_inertia", "rotary_kinetic_energy", "update_directors", "UPDATES"]
 
@@ -65,10 +65,13 @@ _SINGULAR = 1e-12
 def _spin_parts(rule, geom, q, second):
     a = np.einsum("epin,en->epi", rule.Ba, q)
     d, _ = director_field(geom["directors"], rule)
-    gj = spin_coefficients(a, d, second)
-    g = np.stack([j.v for j in gj], axis=-1)                  # (n_el, n_pts, 3)
-    G = np.stack([j.g for j in gj], axis=-2)                  # (..., 3, 3): G[i, k] = dg_i/da_k
-    H = np.stack([j.h for j in gj], axis=-3) if second else None   # (..., 3, 3, 3)
+    if second:
+        gj = spin_coefficients(a, d, True)
+        g = np.stack([j.v for j in gj], axis=-1)              # (n_el, n_pts, 3)
+        G = np.stack([j.g for j in gj], axis=-2)              # (..., 3, 3): G[i, k] = dg_i/da_k
+        H = np.stack([j.h for j in gj], axis=-3)              # (..., 3, 3, 3)
+    else:
+        (g, G), H = spin_gradient(a, d), None
     w = rule.Nt + np.einsum("epin,epi->epn", rule.Ba, g)      # omega1 = w . v
     return a, g, G, H, w
 
@@ -129,8 +132,7 @@ def update_directors(geom, Q, V, variant):
         raise FloatingPointError(
             f"BE3D director update: the director is parallel to the beam axis at node(s) {bad.tolist()} "
             "(the projection of chapter Eq. 99 is singular); use smaller steps so the update follows the axis.")
-    gj = spin_coefficients(a, D, second=False)
-    g = np.stack([j.v for j in gj], axis=-1)
+    g, _ = spin_gradient(a, D)
     omega1 = V[:, 6] + np.einsum("ni,ni->n", g, V[:, 3:6])
     Q, V = Q.copy(), V.copy()
     if variant == "projected":

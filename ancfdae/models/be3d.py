@@ -12,7 +12,7 @@ import numpy as np
 
 from .._validate import choice, finite_vector, positive_int
 from ._be3d_dynamics import UPDATES, rotary_inertia, rotary_kinetic_energy, update_directors
-from ._be3d_kinematics import curvatures, director_field, frames, spin_coefficients
+from ._be3d_kinematics import curvature_energy, curvatures, director_field, frames, spin_gradient
 from ._element import Element
 from ._jet import Jet
 from ._shapes import hermite, linear
@@ -108,19 +108,24 @@ class BE3D(Element):
 
     # -- mesh -------------------------------------------------------------
     def reference_coordinates(self, points, frames_):
-        """``(r, e1, theta_ref)`` per node; stores the initial nodal directors for :meth:`prepare`."""
+        """``(r, e1, theta_ref)`` per node; keeps the initial nodal directors for :meth:`prepare`.
+
+        The director is ``e3`` of each node's frame (``theta_ref = 0``), or the
+        given ``director`` with ``theta_ref`` the angle that turns its
+        projected frame ``(e20, e30)`` into the node's ``(e2, e3)``.
+        """
         frames_ = np.asarray(frames_, dtype=float)
         e1, e2, e3 = frames_[:, :, 0], frames_[:, :, 1], frames_[:, :, 2]
-        if self.director is None or self.director_update == "post-rotated":
-            D, theta = e3.copy(), np.zeros(len(points))
-        else:
+        theta = np.zeros(len(points))
+        if self.director is not None:
             D = np.repeat(self.director[None, :], len(points), axis=0)
             _check_director(D, e1)
-            F, _ = frames(e1, np.zeros(len(points)), D)
-            # theta_ref turns (e20, e30) into the reference (e2, e3): cos = e3.e30, sin = e2.e30
+        if self.director is None or self.director_update == "post-rotated":
+            D = e3.copy()
+        else:
+            F, _ = frames(e1, theta, D)
+            # e3 = cos(theta) e30 - sin(theta) e20 and e2 = cos(theta) e20 + sin(theta) e30
             theta = np.arctan2(np.einsum("ni,ni->n", e2, F[:, :, 2]), np.einsum("ni,ni->n", e3, F[:, :, 2]))
-        if self.director is not None:
-            _check_director(np.repeat(self.director[None, :], len(points), axis=0), e1)
         self._pending = D
         return np.concatenate([points, e1, theta[:, None]], axis=1)
 
@@ -201,7 +206,7 @@ class BE3D(Element):
         rule = self._rule(np.atleast_1d(np.asarray(s, dtype=float)), geom["L"])
         a = np.einsum("epin,en->epi", rule.Ba, q)
         d, _ = director_field(geom["directors"], rule)
-        g = np.stack([j.v for j in spin_coefficients(a, d, False)], axis=-1)
+        g, _ = spin_gradient(a, d)
         return np.einsum("epn,en->ep", rule.Nt, v) + np.einsum("epi,epin,en->ep", g, rule.Ba, v)
 
     def mass_matrix(self, geom):
@@ -210,25 +215,24 @@ class BE3D(Element):
 
     def strain_energy(self, geom, q):
         U, _, _ = axial_energy(geom["axial"], q, geom["slope_ref"], self.EA, False)
-        k = self._curvatures(geom, q, None)
-        r = np.stack([ki.v for ki in k], axis=-1) - geom["k_ref"]
-        return U + 0.5 * np.sum(geom["bend"].wdx * (r**2 @ self.D), axis=1)
+        W, _ = curvature_energy(*self._local(geom, q, geom["bend"]), geom["k_ref"], self.D)
+        return U + np.sum(geom["bend"].wdx * W, axis=1)
 
     def internal_forces(self, geom, q, tangent=True):
         _, f, K = axial_energy(geom["axial"], q, geom["slope_ref"], self.EA, tangent)
         rule = geom["bend"]
-        k = self._curvatures(geom, q, tangent)
+        if not tangent:
+            # residual path: the chain rule written out, no Hessians
+            _, grad = curvature_energy(*self._local(geom, q, rule), geom["k_ref"], self.D)
+            return f + np.einsum("epvn,epv->en", rule.Bx, grad * rule.wdx[..., None]), None
         grad = 0.0
         hess = 0.0
-        for i, ki in enumerate(k):
-            ri = (ki.v - geom["k_ref"][..., i]) * (self.D[i] * rule.wdx)
+        for i, ki in enumerate(self._curvatures(geom, q, True)):
+            wi = self.D[i] * rule.wdx
+            ri = (ki.v - geom["k_ref"][..., i]) * wi
             grad = grad + ri[..., None] * ki.g
-            if tangent:
-                hess = hess + ri[..., None, None] * ki.h + (self.D[i] * rule.wdx)[..., None, None] * (
-                    ki.g[..., :, None] * ki.g[..., None, :])
+            hess = hess + ri[..., None, None] * ki.h + wi[..., None, None] * (ki.g[..., :, None] * ki.g[..., None, :])
         f = f + np.einsum("epvn,epv->en", rule.Bx, grad)
-        if not tangent:
-            return f, None
         return f, K + assemble(rule.Bx, hess)
 
     def shape_matrix(self, s, lengths):
@@ -267,8 +271,9 @@ class BE3D(Element):
         e1 = [x / sp for x in aj]
         Me1 = M[0] * e1[0] + M[1] * e1[1] + M[2] * e1[2]
         Mxe1 = [M[1] * e1[2] - M[2] * e1[1], M[2] * e1[0] - M[0] * e1[2], M[0] * e1[1] - M[1] * e1[0]]
-        g = spin_coefficients(a, d, second=False)
-        fa = [Mxe1[i] / sp + g[i] * Me1 for i in range(3)]
+        g, G = spin_gradient(a, d)
+        gj = [Jet(g[i], G[i]) for i in range(3)]
+        fa = [Mxe1[i] / sp + gj[i] * Me1 for i in range(3)]
         f = Sx.T @ np.array([x.v for x in fa]) + Nt * Me1.v
         if not tangent:
             return f, None
