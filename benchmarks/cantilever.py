@@ -28,7 +28,7 @@ from . import _exudyn_peer as peer
 
 #: Exudyn's counterpart of each element type (runner(n, repeats, criterion)).
 PEERS = {"BE2D": peer.cantilever_be2d,
-         "SQ3D": lambda n, repeats, criterion: peer.cantilever_beam3d(n, repeats=repeats)}
+         "SQ3D": peer.cantilever_beam3d}
 
 
 def ours(name: str, n_elements: int, repeats: int, **options) -> dict:
