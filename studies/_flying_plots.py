@@ -77,7 +77,7 @@ def plot_flying3d(records, path):
             continue
         ls = "-" if r["element"] == "SQ3D" else "--"
         ax.plot(r["t"], r["energy"]["kinetic"] + r["energy"]["strain"], ls, lw=1,
-                label=f"{r['element']} {r['n']} el" + ("" if r["status"] == "success" else f" (fails {r['t_end_reached']:.2f} s)"))
+                label=f"{r['element']} {r['n']} el, h {r['h']:g}" + ("" if r["status"] == "success" else f" (fails {r['t_end_reached']:.2f} s)"))
     ax.set(xlabel="t (s)", ylabel="T + U (J)", title="B3: total energy (chapter Fig. 11)")
     ymax = max((np.nanmax(r["energy"]["kinetic"] + r["energy"]["strain"]) for r in records
                 if r["element"] == "SQ3D" and r["energy"] is not None), default=None)
@@ -93,7 +93,7 @@ def plot_flying3d(records, path):
         for r in (r for r in records if r["element"] == kind):
             u = r["tip"] - r["tip"][:1]
             for i in range(3):
-                axes[i, j].plot(r["t"], u[:, i], lw=1, label=f"{r['n']} el")
+                axes[i, j].plot(r["t"], u[:, i], lw=1, label=f"{r['n']} el, h {r['h']:g}")
         axes[0, j].set_title(f"{kind}: displacement of B (chapter Fig. 12)")
         for i, c in enumerate("xyz"):
             axes[i, j].set_ylabel(f"u_{c} (m)")

@@ -46,7 +46,7 @@ def _label(case):
     return f"{case['element']} {case['n']} el" + (" (reference)" if case.get("reference") else "")
 
 
-def run(elements=None, n_elements=(2, 4, 8, 16, 32, 64), n_ref: int = 128, n_elements_3d=(2, 4, 8),
+def run(elements=None, n_elements=(2, 4, 8, 16, 32, 64), n_ref: int = 128, n_elements_3d=(2, 4, 8, 16),
         t_end: float = 10.0, h: float = 1e-3, dt_out: float = 0.01, quick: bool = False, out=None,
         jobs: int | None = None, executor=None, plots: bool = True, progress: bool = True) -> dict:
     """Run the study.
