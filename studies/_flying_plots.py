@@ -70,27 +70,41 @@ def plot_flying2d(rows, refs, path):
 
 
 def plot_flying3d(records, path):
-    """Fig. 11 (total energy against time) and Fig. 12 (displacement components of B)."""
-    fig, ax = figure(figsize=(7, 4.2))
-    for r in records:
-        if r["energy"] is None:
-            continue
+    """Fig. 11 (total energy and balance error against time), Fig. 12 (displacement of B), long runs."""
+    main = [r for r in records if not r.get("long")]
+    fig, axes = figure(1, 2, figsize=(12, 4.4))
+    for r in main:
         ls = "-" if r["element"] == "SQ3D" else "--"
-        ax.plot(r["t"], r["energy"]["kinetic"] + r["energy"]["strain"], ls, lw=1,
-                label=f"{r['element']} {r['n']} el, h {r['h']:g}" + ("" if r["status"] == "success" else f" (fails {r['t_end_reached']:.2f} s)"))
-    ax.set(xlabel="t (s)", ylabel="T + U (J)", title="B3: total energy (chapter Fig. 11)")
-    ymax = max((np.nanmax(r["energy"]["kinetic"] + r["energy"]["strain"]) for r in records
-                if r["element"] == "SQ3D" and r["energy"] is not None), default=None)
+        lab = f"{r['element']} {r['n']} el" + (f" ({r['director_update']})" if r["element"] == "BE3D" else "") \
+            + f", h {r['h']:g}" + ("" if r["status"] == "success" else f", fails {r['t_end_reached']:.2f} s")
+        axes[0].plot(r["t"], r["energy"]["kinetic"] + r["energy"]["strain"], ls, lw=1, label=lab)
+        axes[1].semilogy(r["t"], np.abs(r["energy"]["balance"]) + 1e-16, ls, lw=1, label=lab)
+    ymax = max((np.nanmax(r["energy"]["kinetic"] + r["energy"]["strain"]) for r in main if r["element"] == "SQ3D"),
+               default=None)
     if ymax:
-        ax.set_ylim(0, 2.5 * ymax)
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
+        axes[0].set_ylim(0, 1.6 * ymax)
+    axes[0].set(xlabel="t (s)", ylabel="T + U (J)", title="B3: total energy (chapter Fig. 11)")
+    axes[1].set(xlabel="t (s)", ylabel="|T + U - W_ext| (J)", title="energy balance error")
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7)
     save(fig, path, "fig11_energy.png")
 
-    kinds = list(dict.fromkeys(r["element"] for r in records))
+    long = [r for r in records if r.get("long")]
+    if long:
+        fig, ax = figure(figsize=(7, 3.8))
+        for r in long:
+            ax.semilogy(r["t"], np.abs(r["energy"]["balance"]) + 1e-16, lw=1, label=f"SQ3D {r['n']} el, h {r['h']:g}")
+        ax.set(xlabel="t (s)", ylabel="|T + U - W_ext| (J)", title="B3, SQ3D: energy balance error, long run")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+        save(fig, path, "sq3d_long_energy.png")
+
+    kinds = list(dict.fromkeys(r["element"] for r in main))
     fig, axes = figure(3, len(kinds), figsize=(5 * len(kinds), 7), sharex=True, squeeze=False)
     for j, kind in enumerate(kinds):
-        for r in (r for r in records if r["element"] == kind):
+        variant = next((r["director_update"] for r in main if r["element"] == kind), None)
+        for r in (r for r in main if r["element"] == kind and r["director_update"] == variant):
             u = r["tip"] - r["tip"][:1]
             for i in range(3):
                 axes[i, j].plot(r["t"], u[:, i], lw=1, label=f"{r['n']} el, h {r['h']:g}")
