@@ -145,17 +145,20 @@ def eps_T(t, tip, t_ref, tip_ref) -> float:
     """Integrated tip error of chapter Eq. 115, ``(int_0^T |u_ref - u|^2 dt)^(1/2)``.
 
     The displacements share their initial position, so ``u_ref - u`` is the
-    difference of positions. Both histories must be sampled on the same grid
-    (the run's samples are matched to the reference by time); the integral is
-    the trapezoidal rule over the samples, and only the first two components
-    are compared (3D types moving in the plane against a planar reference
-    lose nothing: their z stays 0).
+    difference of positions. The run's samples are matched to the reference's
+    by time (both on the same output grid); the integral is the trapezoidal
+    rule over the samples up to the end of the shorter of the two histories
+    (a failed run or reference ends early: compare ``t[-1]``). Only the first
+    two components are compared (3D types moving in the plane against a
+    planar reference lose nothing: their z stays 0).
     """
     t, t_ref = np.asarray(t), np.asarray(t_ref)
+    keep = t <= t_ref[-1] + 1e-9
+    t, tip = t[keep], np.asarray(tip)[keep]
     idx = np.searchsorted(t_ref, t - 1e-9)
-    if np.any(idx >= t_ref.size) or np.any(np.abs(t_ref[np.minimum(idx, t_ref.size - 1)] - t) > 1e-9):
+    if t.size < 2 or np.any(np.abs(t_ref[np.minimum(idx, t_ref.size - 1)] - t) > 1e-9):
         raise ValueError("`t` must be a subset of the reference's output times.")
-    d = np.asarray(tip)[:, :2] - np.asarray(tip_ref)[idx, :2]
+    d = tip[:, :2] - np.asarray(tip_ref)[idx, :2]
     e2 = np.sum(d * d, axis=1)
     return float(np.sqrt(np.sum(0.5 * (e2[1:] + e2[:-1]) * np.diff(t))))
 

@@ -19,6 +19,8 @@ Run: ``ancfdae study flying2d [--quick] [--out DIR] [--jobs N]``.
 """
 from __future__ import annotations
 
+import pickle
+
 import numpy as np
 
 from ._common import Progress, markdown_table, output_dir, run_cases
@@ -46,7 +48,7 @@ def _label(case):
     return f"{case['element']} {case['n']} el" + (" (reference)" if case.get("reference") else "")
 
 
-def run(elements=None, n_elements=(2, 4, 8, 16, 32, 64), n_ref: int = 128, n_elements_3d=(2, 4, 8, 16),
+def run(elements=None, n_elements=(2, 4, 8, 16, 32, 64), n_ref: int = 128, n_elements_3d=(2, 4, 8),
         t_end: float = 10.0, h: float = 1e-3, dt_out: float = 0.01, quick: bool = False, out=None,
         jobs: int | None = None, executor=None, plots: bool = True, progress: bool = True) -> dict:
     """Run the study.
@@ -99,6 +101,10 @@ def run(elements=None, n_elements=(2, 4, 8, 16, 32, 64), n_ref: int = 128, n_ele
     cases.sort(key=lambda c: -_COST[c["element"]] * c["n"])   # longest first: better balanced pools
     records = run_cases(run_case, cases, executor=executor, jobs=jobs,
                         progress=Progress("flying2d", len(cases), progress))
+    path = output_dir("flying2d", out) if plots else None
+    if path is not None:   # keep the histories: post-processing can be redone without the runs
+        with open(path / "records.pkl", "wb") as f:
+            pickle.dump(records, f)
     refs = {FAMILY[r["element"]]: r for r in records if r["reference"]}
     by_key = {(r["element"], r["n"]): r for r in records}
     rows = []
@@ -107,7 +113,7 @@ def run(elements=None, n_elements=(2, 4, 8, 16, 32, 64), n_ref: int = 128, n_ele
         for r in sorted((r for r in records if r["element"] == name and not r["reference"]), key=lambda r: r["n"]):
             row = _row(r, ref, t_end)
             twin = by_key.get((_TWIN[name], r["n"]))
-            if name != _TWIN[name] and twin is not None and twin["status"] == "success":
+            if name != _TWIN[name] and twin is not None and twin["status"] == r["status"] == "success":
                 row["twin_difference"] = float(np.max(np.abs(r["tip"][:, :2] - twin["tip"][:, :2])))
                 row["max_abs_z"] = float(np.max(np.abs(r["tip"][:, 2])))
             rows.append(row)
@@ -120,9 +126,7 @@ def run(elements=None, n_elements=(2, 4, 8, 16, 32, 64), n_ref: int = 128, n_ele
             orders[name] = regress_order([r["n"] for r in rs], [r["eps_T"] for r in rs])
     references = {fam: _row(r, None, t_end) for fam, r in refs.items()}
     table = _table(rows, references, orders, n_ref, t_end, h)
-    path = None
     if plots:
-        path = output_dir("flying2d", out)
         (path / "flying2d.md").write_text("# B2 free beam flying in plane (chapter Sect. 5.2)\n\n" + table)
         from ._flying_plots import plot_flying2d
         plot_flying2d(rows, refs, path)
@@ -135,8 +139,10 @@ def _row(r, ref, t_end):
            "cpu": r["cpu"], "steps": st["steps"], "newton_iterations": st["newton_iterations"],
            "jacobian_evals": st["jacobian_evals"], "factorizations": st["factorizations"],
            "eps_T": float("nan"), "drift": float("nan")}
-    if ref is not None and r["status"] == "success":
+    row["t_reached"] = float(r["t"][-1])
+    if ref is not None and r["t"].size > 1:
         row["eps_T"] = eps_T(r["t"], r["tip"], ref["t"], ref["tip"])
+        row["eps_span"] = float(min(r["t"][-1], ref["t"][-1]))
     if r["energy"] is not None and t_end > T_PULSE:
         row["drift"] = steady_drift(r["t"], r["energy"]["balance"], T_PULSE)["max"]
         row["energy"] = float(r["energy"]["total"][-1])
@@ -149,10 +155,12 @@ def _table(rows, references, orders, n_ref, t_end, h):
 
     def line(r, eps):
         its = r["newton_iterations"] / max(r["steps"], 1)
+        status = r["status"] if r["status"] == "success" else f"failed at {r['t_reached']:.3f} s"
         return [r["element"], r["n"], r["dof"], eps, r["cpu"], r["newton_iterations"], f"{its:.2f}",
-                r["jacobian_evals"], r["factorizations"], f"{r['drift']:.2e}", r["status"]]
+                r["jacobian_evals"], r["factorizations"], f"{r['drift']:.2e}", status]
 
-    body = [line(r, f"{r['eps_T']:.3e}") for r in rows]
+    body = [line(r, f"{r['eps_T']:.3e}" + ("" if r.get("eps_span", t_end) >= t_end - 1e-9
+                                            else f" (to {r['eps_span']:.2f} s)")) for r in rows]
     body += [line(r, "reference") for r in references.values()]
     text = (f"Lobatto IIIA (3 stages), h = {h:g} s, modified Newton tol 1e-8, T = {t_end:g} s; "
             f"reference: {n_ref} elements of each family.\n\n")

@@ -54,3 +54,13 @@ def test_writes_table_and_figure(quick):
 def test_rejects_unknown_method():
     with pytest.raises(ValueError, match="methods"):
         integrators.run(methods=["euler"], quick=True, plots=False, progress=False)
+
+
+def test_sweeps_run_through_any_executor():
+    """A concurrent.futures executor (or Dask's ``Client().get_executor()``) drives the sweep."""
+    from concurrent.futures import ThreadPoolExecutor
+    with ThreadPoolExecutor(max_workers=2) as ex:
+        res = integrators.run(quick=True, methods=["lobatto3"], executor=ex, plots=False, progress=False)
+    serial = integrators.run(quick=True, methods=["lobatto3"], jobs=1, plots=False, progress=False)
+    assert [r["eps_T"] for r in res["rows"]] == [r["eps_T"] for r in serial["rows"]]
+    assert 3.8 < res["orders"]["B2"]["lobatto3"] < 4.2
