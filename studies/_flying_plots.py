@@ -23,25 +23,34 @@ def save(fig, path, name):
     plt.close(fig)
 
 
-def plot_flying2d(rows, refs, path):
+def plot_flying2d(rows, refs, path, t_window=None):
     """Fig. 8 (eps_T against elements and DOF), Fig. 9 (CPU against eps_T), tip path and energy."""
     names = list(dict.fromkeys(r["element"] for r in rows))
     ok = [r for r in rows if np.isfinite(r["eps_T"]) and r["eps_T"] > 0]
-    fig, axes = figure(1, 2, figsize=(10, 4))
+    t_end = max(float(r["t"][-1]) for r in refs.values())
+    fig, axes = figure(1, 2, figsize=(10, 4.2))
     for name in names:
         rs = [r for r in ok if r["element"] == name]
-        ls = "o-" if name.endswith("2D") else "s--"
-        axes[0].loglog([r["n"] for r in rs], [r["eps_T"] for r in rs], ls, color=_STYLE.get(name), label=name)
-        axes[1].loglog([r["dof"] for r in rs], [r["eps_T"] for r in rs], ls, color=_STYLE.get(name), label=name)
+        mk = "o" if name.endswith("2D") else "s"
+        for key, ls, lab in (("eps_T", "-", f"{name}, [0, T]"), ("eps_window", ":", f"{name}, [0, {t_window:g} s]")):
+            if key == "eps_window" and t_window is None:
+                continue
+            axes[0].loglog([r["n"] for r in rs], [r[key] for r in rs], ls, marker=mk, color=_STYLE.get(name),
+                           mfc="none" if name.endswith("3D") else None, label=lab)
+            axes[1].loglog([r["dof"] for r in rs], [r[key] for r in rs], ls, marker=mk, color=_STYLE.get(name),
+                           mfc="none" if name.endswith("3D") else None, label=lab)
     if ok:
-        n = np.array([4.0, max(r["n"] for r in ok)])
-        e4 = max(r["eps_T"] for r in ok if r["n"] == min(r["n"] for r in ok))
-        axes[0].loglog(n, e4 * 0.1 * (n / 4) ** -4, "k:", label="order 4")
+        n = np.array([8.0, max(r["n"] for r in ok)])
+        e8 = min(r.get("eps_window", r["eps_T"]) for r in ok if r["n"] == 8) if any(r["n"] == 8 for r in ok) else 1e-3
+        axes[0].loglog(n, e8 * 0.3 * (n / 8) ** -4, "k--", lw=0.8, label="order 4")
+    meshes = sorted({r["n"] for r in ok})
+    axes[0].set_xticks(meshes, [str(m) for m in meshes])
+    axes[0].set_xticks([], minor=True)
     axes[0].set(xlabel="number of elements", ylabel="eps_T (Eq. 115)")
     axes[1].set(xlabel="degrees of freedom", ylabel="eps_T (Eq. 115)")
     for ax in axes:
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend()
+        ax.legend(fontsize=7)
     fig.suptitle("B2 beam flying in plane: integrated tip error (chapter Fig. 8)")
     save(fig, path, "fig8_convergence.png")
 

@@ -19,8 +19,12 @@ def test_eps_T_falls_with_the_mesh_at_a_regressed_order(quick):
         assert all(r["status"] == "success" for r in rows)
         eps = np.array([r["eps_T"] for r in rows])
         assert np.all(np.diff(eps) < 0), eps
-        # pre-asymptotic on these coarse meshes (full study: order ~4); measured 3.19 and 2.44
-        assert 2.0 < quick["orders"][name] < 5.0
+        # pre-asymptotic on 2-8 elements (full study, 16-64 el over [0, 4 s]: 3.85 and 3.67); measured
+        # 2.37 / 1.82 over [0, 1.5 s] and 3.12 / 2.59 over [0, 1 s] (BE2D / SQ2D)
+        assert 1.5 < quick["orders"][name] < 5.0
+        assert 2.2 < quick["orders_window"][name] < 5.0
+        assert quick["orders_window"][name] > quick["orders"][name]
+        assert all(r["eps_window"] < r["eps_T"] for r in rows)
     be = {r["n"]: r for r in quick["rows"] if r["element"] == "BE2D"}
     assert be[8]["eps_T"] == pytest.approx(5.023e-3, rel=2e-2)
     assert be[4]["eps_T"] == pytest.approx(4.589e-2, rel=2e-2)
