@@ -17,6 +17,7 @@ Run: ``ancfdae study energy [--quick] [--out DIR] [--jobs N]``.
 from __future__ import annotations
 
 import os
+import pickle
 
 import numpy as np
 
@@ -117,11 +118,13 @@ def run(elements=None, integrators=tuple(INTEGRATORS), n: int | None = None, t_e
                         progress=Progress("energy", len(cases), progress))
     key = {k: i for i, k in enumerate(INTEGRATORS)}
     records.sort(key=lambda r: (list(ELEMENTS).index(r["element"]), key[r["integrator"]]))
+    path = output_dir("energy", out) if plots else None
+    if path is not None:   # keep the histories: post-processing can be redone without the runs
+        with open(path / "records.pkl", "wb") as f:
+            pickle.dump(records, f)
     rows = [summarize(r) for r in records]
     table = _table(rows, h)
-    path = None
     if plots:
-        path = output_dir("energy", out)
         (path / "energy.md").write_text("# Energy drift in free flight\n\n" + table)
         _plot(records, path)
     return {"rows": rows, "records": records, "table": table, "path": path}
@@ -156,9 +159,8 @@ def _plot(records, path):
             if m.sum() < 2:
                 continue
             bal = r["energy"]["balance"][m]
-            ax.plot(r["t"][m], bal - bal[0], color=f"C{k}", lw=1, label=r["integrator"])
-        ax.set_yscale("symlog", linthresh=1e-8)
-        ax.set(xlabel="t (s)", ylabel="E(t) - E(t_load) (J)", title=f"{name}: energy drift after the load")
+            ax.semilogy(r["t"][m], np.abs(bal - bal[0]) + 1e-14, color=f"C{k}", lw=1, label=r["integrator"])
+        ax.set(xlabel="t (s)", ylabel="|E(t) - E(t_load)| (J)", title=f"{name}: energy drift after the load")
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7)
     for ax in axes.ravel()[len(names):]:

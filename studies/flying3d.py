@@ -22,6 +22,8 @@ Run: ``ancfdae study flying3d [--quick] [--out DIR] [--jobs N]``.
 """
 from __future__ import annotations
 
+import pickle
+
 import numpy as np
 
 from ._common import Progress, markdown_table, output_dir, run_cases
@@ -167,11 +169,13 @@ def run(be_meshes=(8, 16, 32), sq_meshes=(32, 64, 128), variants=("projected", "
     order = {"BE3D": 0, "SQ3D": 1}
     records.sort(key=lambda r: (order[r["element"]], r["director_update"] != variants[0], r["t_end"], r["n"],
                                 -r["h"]))
+    path = output_dir("flying3d", out) if plots else None
+    if path is not None:   # keep the histories: post-processing can be redone without the runs
+        with open(path / "records.pkl", "wb") as f:
+            pickle.dump(records, f)
     rows = [summarize(r) for r in records]
     table = _table(rows, h, missing)
-    path = None
     if plots:
-        path = output_dir("flying3d", out)
         (path / "flying3d.md").write_text("# B3 free beam flying in space (chapter Sect. 5.3)\n\n" + table)
         from ._flying_plots import plot_flying3d
         plot_flying3d(records, path)
