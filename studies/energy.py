@@ -141,7 +141,8 @@ def _table(rows, h):
              f"{r['t_reached']:.2f}", _f(r["t_fail"], ".2f") if r["failed"] else "-", _f(r["t_blow_up"], ".2f"),
              _f(r["energy"], ".4g"), _f(r["drift"], ".2e"), _f(r["relative"], ".1e"), _f(r["rate"], ".1e"),
              f"{r['cpu']:.1f}"] for r in rows]
-    text = (f"Fixed-step methods: h = {h:g} s, modified Newton tol 1e-8; IDA: rtol 1e-6, max order 2, at most 400 000 steps. "
+    text = (f"Fixed-step methods: h = {h:g} s, modified Newton tol 1e-8; IDA: rtol 1e-6, max order 2, "
+            "at most 400 000 steps. "
             "Planar elements: B2 (load ends at 2.5 s); spatial: B3 (load ends at 3 s).\n\n")
     return text + markdown_table(headers, body)
 
