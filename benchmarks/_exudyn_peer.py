@@ -183,7 +183,7 @@ def cantilever_be2d(n_elements, repeats=3, criterion="ours"):
     return _cantilever(_build_b1_be2d, n_elements, repeats, B1_REF_BE, criterion)
 
 
-def cantilever_beam3d(n_elements, repeats=3):
+def cantilever_beam3d(n_elements, repeats=3, criterion="ours"):
     """Benchmark B1 with Exudyn's ObjectANCFBeam (shear deformable, linear, finite-difference Jacobian).
 
     Same load stepping, tolerance and timing as :func:`cantilever_be2d`; nodes NodePointSlope23
@@ -202,7 +202,7 @@ def cantilever_beam3d(n_elements, repeats=3):
     dict
         Same keys as :func:`cantilever_be2d`.
     """
-    return _cantilever(_build_b1_beam3d, n_elements, repeats, B1_REF_SQ)
+    return _cantilever(_build_b1_beam3d, n_elements, repeats, B1_REF_SQ, criterion)
 
 def main(argv=None):
     """Print the peer's numbers: B1 with both elements, then the pendulum runs (median of repeats)."""

@@ -1,118 +1,140 @@
-"""Second-order forward-mode automatic differentiation on NumPy arrays ("jets").
+"""Second-order forward differentiation ("jets") of small vector expressions, vectorised over points.
 
-A :class:`Jet` carries a value and its exact gradient and Hessian with respect
-to ``n`` local variables, for a whole batch of points at once: ``v`` has the
-batch shape ``S`` (e.g. ``(n_el, n_pts)``), ``g`` the shape ``S + (n,)`` and
-``h`` the shape ``S + (n, n)``; ``h`` is None in first-order mode (residuals
-need gradients only, tangents need Hessians too).
-
-The BE3D element writes its curvature, twist and cross-section angular
-velocity as short expressions in a few polynomial invariants of the slope
-``r'`` and its derivative ``r''``; propagating jets through those expressions
-gives the exact first and second derivatives without hand-expanded formulae
-(design.md Sect. 3: exact Jacobians, analytic or automatic differentiation).
+The SQ elements need the frame of chapter Eq. 7 and its first *and second*
+derivatives with respect to the cross-section slopes, for exact tangents. The
+frame is a short chain of products, cross products, square roots and
+reciprocals of at most six variables, so it is propagated here as a jet:
+value ``v`` of shape ``(P, *shape)``, gradient ``g`` ``(P, *shape, K)`` and
+Hessian ``h`` ``(P, *shape, K, K)`` over ``K`` variables, for ``P`` points at
+once (no loop over points). Every rule is the plain product or chain rule, so
+the derivatives are exact to rounding. A jet of order 1 carries no Hessian
+(``h is None``), one of order 0 no gradient either: the residual pays only for
+what it uses.
 """
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["Jet", "const", "dot"]
-
-
-def _outer(a, b):
-    return a[..., :, None] * b[..., None, :]
+__all__ = ["Jet", "variables", "dot", "cross", "mul", "sqrt", "recip", "linear", "combine"]
 
 
 class Jet:
-    """Value, gradient and (optionally) Hessian of a scalar field over a batch of points."""
+    """Value, gradient and Hessian of a scalar (shape ``()``) or vector (shape ``(d,)``) quantity."""
 
     __slots__ = ("v", "g", "h")
-    # Make ``ndarray * Jet`` call Jet.__rmul__ instead of broadcasting over an object.
-    __array_ufunc__ = None
 
-    def __init__(self, v, g, h=None):
-        self.v = v
-        self.g = g
-        self.h = h
+    def __init__(self, v, g=None, h=None):
+        self.v, self.g, self.h = v, g, h
 
     @property
-    def second(self) -> bool:
-        """True when Hessians are propagated."""
-        return self.h is not None
+    def is_vector(self) -> bool:
+        return self.v.ndim == 2
 
-    # -- arithmetic ---------------------------------------------------------
-    def __add__(self, o):
-        if isinstance(o, Jet):
-            return Jet(self.v + o.v, self.g + o.g, None if self.h is None else self.h + o.h)
-        return Jet(self.v + o, self.g, self.h)
-
-    __radd__ = __add__
-
-    def __neg__(self):
-        return Jet(-self.v, -self.g, None if self.h is None else -self.h)
-
-    def __sub__(self, o):
-        return self + (-o)
-
-    def __rsub__(self, o):
-        return (-self) + o
-
-    def __mul__(self, o):
-        if isinstance(o, Jet):
-            a, b = self, o
-            g = a.g * b.v[..., None] + b.g * a.v[..., None]
-            h = None
-            if a.h is not None:
-                ab = _outer(a.g, b.g)
-                h = a.h * b.v[..., None, None] + b.h * a.v[..., None, None] + ab + np.swapaxes(ab, -1, -2)
-            return Jet(a.v * b.v, g, h)
-        o = np.asarray(o)
-        return Jet(self.v * o, self.g * o[..., None], None if self.h is None else self.h * o[..., None, None])
-
-    __rmul__ = __mul__
-
-    def __truediv__(self, o):
-        if isinstance(o, Jet):
-            return self * o.reciprocal()
-        return self * (1.0 / np.asarray(o))
-
-    def __rtruediv__(self, o):
-        return self.reciprocal() * o
-
-    def _chain(self, f0, f1, f2):
-        """Compose with a scalar function given its value and first two derivatives."""
-        g = self.g * f1[..., None]
-        h = None
-        if self.h is not None:
-            h = self.h * f1[..., None, None] + _outer(self.g, self.g) * f2[..., None, None]
-        return Jet(f0, g, h)
-
-    def reciprocal(self):
-        r = 1.0 / self.v
-        return self._chain(r, -r * r, 2.0 * r * r * r)
-
-    def sqrt(self):
-        s = np.sqrt(self.v)
-        return self._chain(s, 0.5 / s, -0.25 / (s * self.v))
-
-    def square(self):
-        return self._chain(self.v * self.v, 2.0 * self.v, np.full_like(self.v, 2.0))
-
-    def cos(self):
-        c, s = np.cos(self.v), np.sin(self.v)
-        return self._chain(c, -s, -c)
-
-    def sin(self):
-        c, s = np.cos(self.v), np.sin(self.v)
-        return self._chain(s, c, -s)
+    def __neg__(self) -> "Jet":
+        return Jet(-self.v, None if self.g is None else -self.g, None if self.h is None else -self.h)
 
 
-def const(v, n: int, second: bool) -> Jet:
-    """A jet of a quantity that does not depend on the variables."""
-    v = np.asarray(v, dtype=float)
-    return Jet(v, np.zeros(v.shape + (n,)), np.zeros(v.shape + (n, n)) if second else None)
+def variables(*blocks: np.ndarray, order: int = 2) -> list[Jet]:
+    """Vector jets of the independent variables, one per block of shape ``(P, d)``."""
+    P = blocks[0].shape[0]
+    K = sum(b.shape[1] for b in blocks)
+    out, k = [], 0
+    for b in blocks:
+        d = b.shape[1]
+        g = h = None
+        if order >= 1:
+            g = np.zeros((P, d, K))
+            g[:, np.arange(d), k + np.arange(d)] = 1.0
+        if order >= 2:
+            h = np.zeros((P, d, K, K))
+        k += d
+        out.append(Jet(b, g, h))
+    return out
 
 
-def dot(u, w) -> Jet:
-    """Dot product of two 3-vectors given as sequences of jets (or arrays)."""
-    return u[0] * w[0] + u[1] * w[1] + u[2] * w[2]
+def _sym(o):
+    return o + np.swapaxes(o, -1, -2)
+
+
+def mul(a: Jet, b: Jet) -> Jet:
+    """Scalar jet ``a`` times scalar or vector jet ``b``."""
+    e = (slice(None), None) if b.is_vector else (slice(None),)
+    av = a.v[e]
+    v = av * b.v
+    if a.g is None:
+        return Jet(v)
+    ag = a.g[e]
+    g = av[..., None] * b.g + ag * b.v[..., None]
+    if a.h is None:
+        return Jet(v, g)
+    h = av[..., None, None] * b.h + a.h[e] * b.v[..., None, None] + _sym(ag[..., :, None] * b.g[..., None, :])
+    return Jet(v, g, h)
+
+
+def dot(a: Jet, b: Jet) -> Jet:
+    """Scalar product of two vector jets."""
+    v = np.einsum("pc,pc->p", a.v, b.v)
+    if a.g is None:
+        return Jet(v)
+    g = np.einsum("pck,pc->pk", a.g, b.v) + np.einsum("pc,pck->pk", a.v, b.g)
+    if a.h is None:
+        return Jet(v, g)
+    h = (np.einsum("pckl,pc->pkl", a.h, b.v) + np.einsum("pc,pckl->pkl", a.v, b.h)
+         + _sym(np.einsum("pck,pcl->pkl", a.g, b.g)))
+    return Jet(v, g, h)
+
+
+def _cx(x, y):
+    """Cross product over axis 1 (broadcasting over the trailing axes)."""
+    return np.stack([x[:, 1] * y[:, 2] - x[:, 2] * y[:, 1],
+                     x[:, 2] * y[:, 0] - x[:, 0] * y[:, 2],
+                     x[:, 0] * y[:, 1] - x[:, 1] * y[:, 0]], axis=1)
+
+
+def cross(a: Jet, b: Jet) -> Jet:
+    """Cross product of two 3-vector jets."""
+    v = _cx(a.v, b.v)
+    if a.g is None:
+        return Jet(v)
+    g = _cx(a.g, b.v[:, :, None]) + _cx(a.v[:, :, None], b.g)
+    if a.h is None:
+        return Jet(v, g)
+    h = (_cx(a.h, b.v[:, :, None, None]) + _cx(a.v[:, :, None, None], b.h)
+         + _sym(_cx(a.g[:, :, :, None], b.g[:, :, None, :])))    # a_k x b_l + a_l x b_k
+    return Jet(v, g, h)
+
+
+def _unary(a: Jet, f, f1, f2) -> Jet:
+    """Chain rule for a scalar function with value f and derivatives f1, f2 at ``a.v``."""
+    if a.g is None:
+        return Jet(f)
+    g = f1[..., None] * a.g
+    if a.h is None:
+        return Jet(f, g)
+    return Jet(f, g, f1[..., None, None] * a.h + f2[..., None, None] * a.g[..., :, None] * a.g[..., None, :])
+
+
+def sqrt(a: Jet) -> Jet:
+    r = np.sqrt(a.v)
+    return _unary(a, r, 0.5 / r, -0.25 / (r * a.v))
+
+
+def recip(a: Jet) -> Jet:
+    inv = 1.0 / a.v
+    return _unary(a, inv, -inv**2, 2.0 * inv**3)
+
+
+def linear(M: np.ndarray, a: Jet) -> Jet:
+    """Constant matrix ``M`` (d x d) applied to the components of a vector jet."""
+    return Jet(np.einsum("ij,pj->pi", M, a.v), None if a.g is None else np.einsum("ij,pjk->pik", M, a.g),
+               None if a.h is None else np.einsum("ij,pjkl->pikl", M, a.h))
+
+
+def combine(weights, jets: list[Jet]) -> Jet:
+    """``sum_k weights[k] * jets[k]`` with per-point constant weights (arrays of shape (P,))."""
+    def part(name):
+        xs = [getattr(j, name) for j in jets]
+        if xs[0] is None:
+            return None
+        return sum(w.reshape(w.shape + (1,) * (x.ndim - 1)) * x for w, x in zip(weights, xs))
+    return Jet(part("v"), part("g"), part("h"))
