@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["Jet", "const", "dot"]
+__all__ = ["Jet"]
 
 
 def _outer(a, b):
@@ -109,13 +109,3 @@ class Jet:
         c, s = np.cos(self.v), np.sin(self.v)
         return self._chain(s, c, -s)
 
-
-def const(v, n: int, second: bool) -> Jet:
-    """A jet of a quantity that does not depend on the variables."""
-    v = np.asarray(v, dtype=float)
-    return Jet(v, np.zeros(v.shape + (n,)), np.zeros(v.shape + (n, n)) if second else None)
-
-
-def dot(u, w) -> Jet:
-    """Dot product of two 3-vectors given as sequences of jets (or arrays)."""
-    return u[0] * w[0] + u[1] * w[1] + u[2] * w[2]
