@@ -277,9 +277,11 @@ class Beam:
         return V.reshape(-1)[self.free]
 
     def mass(self, q=None) -> sp.csr_matrix:
-        """Mass matrix M(q) (constant unless the element says otherwise)."""
-        if self.mass_is_constant or q is None:
+        """Mass matrix M(q) (constant unless the element says otherwise; ``q=None``: the reference state)."""
+        if self.mass_is_constant:
             return self._asm.csr(self._M_data.copy())
+        if q is None:
+            q = self.q_ref[self.free]
         _, blocks = self._inertia(q, np.zeros(self.n_dof), np.zeros(self.n_dof), True)
         return self._asm.csr(self._M_data + blocks[2])
 
