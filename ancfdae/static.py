@@ -95,7 +95,13 @@ def solve_static(model, load_steps: int = 10, *, t: float = 0.0, q0=None, tol: f
             lam = i / load_steps
             if saved is not None:
                 model.load_factor = saved * lam
-            out = solver.solve(lambda x: model.residual(t, x, z, z), lambda x: model.jacobian(t, x, z, z).K, q)
+            fused = None
+            if hasattr(model, "residual_jacobian"):
+                def fused(x):
+                    r, J = model.residual_jacobian(t, x, z, z)
+                    return r, J.K
+            out = solver.solve(lambda x: model.residual(t, x, z, z), lambda x: model.jacobian(t, x, z, z).K, q,
+                               residual_jacobian=fused)
             steps.append({"load_factor": lam, "iterations": out.iterations, "residual": out.residual_norm,
                           "converged": out.converged, "q": out.x if out.converged else q.copy()})
             if not out.converged:

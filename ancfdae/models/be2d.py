@@ -112,13 +112,11 @@ class BE2D(Element):
         w = np.concatenate([wa, wb])
         _, dN, ddN = hermite(s, lengths)                         # (n_el, n_pts, 4)
         n_el, n_pts = dN.shape[:2]
-        is_a = np.zeros(n_pts, dtype=bool)
-        is_a[:sa.size] = True
         geom = {"L": lengths, "w": w[None, :] * lengths[:, None] / 2.0,
                 "dN_e": dN, "ddN_e": ddN,                                   # (n_el, n_pts, 4): for r', r''
                 "dN": np.ascontiguousarray(dN.transpose(2, 0, 1))[:, None],  # (4, 1, n_el, n_pts)
                 "ddN": np.ascontiguousarray(ddN.transpose(2, 0, 1))[:, None],
-                "is_a": is_a, "is_b": ~is_a}
+                "n_a": sa.size}
         # Constant Hessians of g = r'.r' and c = (r' x r'').e_z, stacked as (n_el, 2*n_pts, 64).
         I2 = np.eye(2)
         d2g = 2.0 * np.einsum("epk,epl,ab->epkalb", dN, dN, I2)
@@ -162,45 +160,59 @@ class BE2D(Element):
     def _densities(self, g, c, geom, hessian=True):
         """Energy density derivatives in (g, c): (W, Wg, Wc[, Wgg, Wgc, Wcc]), each (n_el, n_pts).
 
-        Axial terms act at the axial rule's points, bending terms at the
-        bending rule's points.
+        Axial terms act at the axial rule's points (the first ``n_a``), bending
+        terms at the bending rule's points; each is evaluated on its own slice.
         """
         E, sec = self.material.E, self.section
         EA, EI = E * sec.A, E * sec.I3
-        a_pts, b_pts = geom["is_a"], geom["is_b"]
+        na = geom["n_a"]
+        ga, gb, cb = g[:, :na], g[:, na:], c[:, na:]
+        out = [np.empty_like(g) for _ in range(6 if hessian else 3)]
         if self.formulation == "structural":
-            a = 1.0 + geom["eps_ref"]
-            rg = np.sqrt(g)
-            Kr = geom["K_ref"]
-            K = c / g
+            a = 1.0 + geom["eps_ref"][:, :na]
+            rg = np.sqrt(ga)
+            Kr = geom["K_ref"][:, na:]
+            igb = 1.0 / gb
+            K = cb * igb
             dK = K - Kr
-            W = np.where(a_pts, 0.5 * EA * (rg - a) ** 2, 0.5 * EI * dK**2)
-            Wg = np.where(a_pts, EA * (0.5 - a / (2 * rg)), -EI * dK * K / g)
-            Wc = (EI * b_pts) * dK / g
-            if not hessian:
-                return W, Wg, Wc
-            Wgg = np.where(a_pts, EA * a / (4 * g * rg), EI * (3 * K**2 - 2 * Kr * K) / g**2)
-            Wgc = (-EI * b_pts) * (2 * K - Kr) / g**2
-            Wcc = (EI * b_pts) / g**2
-            return W, Wg, Wc, Wgg, Wgc, Wcc
-        a = 0.5 * (g - 1.0)
+            out[0][:, :na] = 0.5 * EA * (rg - a) ** 2
+            out[0][:, na:] = 0.5 * EI * dK * dK
+            out[1][:, :na] = EA * (0.5 - 0.5 * a / rg)
+            out[1][:, na:] = -EI * dK * K * igb
+            out[2][:, :na] = 0.0
+            out[2][:, na:] = EI * dK * igb
+            if hessian:
+                igb2 = igb * igb
+                out[3][:, :na] = 0.25 * EA * a / (ga * rg)
+                out[3][:, na:] = EI * (3 * K - 2 * Kr) * K * igb2
+                out[4][:, :na] = 0.0
+                out[4][:, na:] = -EI * (2 * K - Kr) * igb2
+                out[5][:, :na] = 0.0
+                out[5][:, na:] = EI * igb2
+            return out
+        a = 0.5 * (ga - 1.0)
         I, I4 = sec.I3, sec.I4
-        ig = 1.0 / g
+        ig = 1.0 / gb
         phi = (1.5 - 0.5 * ig) * ig
         phi1 = (-1.5 + ig) * ig**2
         psi, psi1 = 0.25 * ig**4, -ig**5
-        c2 = c * c
-        W = np.where(a_pts, 0.5 * EA * a**2, 0.5 * E * (I * c2 * phi + I4 * c2 * c2 * psi))
-        Wg = np.where(a_pts, 0.5 * EA * a, 0.5 * E * (I * c2 * phi1 + I4 * c2 * c2 * psi1))
-        Wc = (E * b_pts) * (I * c * phi + 2 * I4 * c2 * c * psi)
-        if not hessian:
-            return W, Wg, Wc
-        phi2 = (3.0 - 3.0 * ig) * ig**3
-        psi2 = 5.0 * ig**6
-        Wgg = np.where(a_pts, 0.25 * EA, 0.5 * E * (I * c2 * phi2 + I4 * c2 * c2 * psi2))
-        Wgc = (E * b_pts) * (I * c * phi1 + 2 * I4 * c2 * c * psi1)
-        Wcc = (E * b_pts) * (I * phi + 6 * I4 * c2 * psi)
-        return W, Wg, Wc, Wgg, Wgc, Wcc
+        c2 = cb * cb
+        out[0][:, :na] = 0.5 * EA * a**2
+        out[0][:, na:] = 0.5 * E * (I * c2 * phi + I4 * c2 * c2 * psi)
+        out[1][:, :na] = 0.5 * EA * a
+        out[1][:, na:] = 0.5 * E * (I * c2 * phi1 + I4 * c2 * c2 * psi1)
+        out[2][:, :na] = 0.0
+        out[2][:, na:] = E * (I * cb * phi + 2 * I4 * c2 * cb * psi)
+        if hessian:
+            phi2 = (3.0 - 3.0 * ig) * ig**3
+            psi2 = 5.0 * ig**6
+            out[3][:, :na] = 0.25 * EA
+            out[3][:, na:] = 0.5 * E * (I * c2 * phi2 + I4 * c2 * c2 * psi2)
+            out[4][:, :na] = 0.0
+            out[4][:, na:] = E * (I * cb * phi1 + 2 * I4 * c2 * cb * psi1)
+            out[5][:, :na] = 0.0
+            out[5][:, na:] = E * (I * phi + 6 * I4 * c2 * psi)
+        return out
 
     def mass_matrix(self, geom):
         return geom["M"]

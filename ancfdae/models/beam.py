@@ -277,9 +277,11 @@ class Beam:
         return V.reshape(-1)[self.free]
 
     def mass(self, q=None) -> sp.csr_matrix:
-        """Mass matrix M(q) (constant unless the element says otherwise)."""
-        if self.mass_is_constant or q is None:
+        """Mass matrix M(q) (constant unless the element says otherwise; ``q=None``: the reference state)."""
+        if self.mass_is_constant:
             return self._asm.csr(self._M_data.copy())
+        if q is None:
+            q = self.q_ref[self.free]
         _, blocks = self._inertia(q, np.zeros(self.n_dof), np.zeros(self.n_dof), True)
         return self._asm.csr(self._M_data + blocks[2])
 
@@ -305,6 +307,23 @@ class Beam:
             r += self._inertia(q, v, a, False)[0]
         fnc, _ = self._f_nonconservative(t, qf, False)
         return r - self.load_factor * (fnc + self._f_gravity)
+
+    def residual_jacobian(self, t, q, v, a):
+        """``(residual, jacobian)`` from one kernel pass (the fused path of full Newton)."""
+        qf = self.expand(q)
+        fe, ke = self.element.internal_forces(self.geom, qf[self.edofs], True)
+        fnc, kload = self._f_nonconservative(t, qf, True)
+        r = self._asm.vector(fe) + self._asm.csr(self._M_data) @ a - self.load_factor * (fnc + self._f_gravity)
+        K = self._asm.data(ke)
+        if kload is not None:
+            K -= self.load_factor * kload
+        D, M = self._zero_data, self._M_data
+        if not self.mass_is_constant:
+            f_in, (iq, iv, ia) = self._inertia(q, v, a, True)
+            r += f_in
+            K, D, M = K + iq, iv, M + ia
+        return r, JacobianBlocks(self._asm.csr(K), self._asm.csr(D.copy()), self._asm.csr(M.copy()),
+                                 same_pattern=True)
 
     def jacobian(self, t, q, v, a) -> JacobianBlocks:
         """Exact ``dr/dq``, ``dr/dv``, ``dr/da`` with one shared CSR pattern."""

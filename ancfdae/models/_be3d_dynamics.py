@@ -1,0 +1,157 @@
+"""BE3D's configuration-dependent inertia and its director update (chapter Sects. 2.2, 3.5, 3.6).
+
+Kinetic energy and inertia forces
+---------------------------------
+The kinetic energy of the thin beam is that of its axis plus the spin of the
+cross-section about the axis (the bending rotary inertia ``rho I2, rho I3`` is
+neglected, as in every Bernoulli-Euler ANCF element)::
+
+    T = 1/2 int rho A |r_dot|^2 dxi  +  1/2 int rho J omega1^2 dxi,
+    omega1 = omega . e1 = theta_dot + g(r') . r'_dot,
+    g(a)   = (a.d) (d x a) / (|a| |d x a|^2)               (d: director).
+
+``omega1 = e2_dot . e3`` follows from Eqs. 96-100 exactly like the twist
+``k1`` (see :mod:`._be3d_kinematics`), with the director constant in time
+between updates. With the element coordinates ``q`` and, at a point,
+``a = Ba q``, ``theta = Nt q``, the spin is linear in the velocities,
+``omega1 = w(q) . v`` with ``w = Nt + Ba^T g(a)``, so
+
+    T_rot = 1/2 v^T M_rot(q) v,    M_rot(q) = int rho J w w^T dxi.
+
+Lagrange's equations ``d/dt dT/dv - dT/dq`` give the rotary inertia force
+(``G = dg/da``, ``a_dot = Ba v``, ``a_ddot = Ba a``)::
+
+    f_rot = int rho J [ w Omega + omega1 Ba^T (G - G^T) a_dot ] dxi,
+    Omega = omega1_dot = w . a_acc + a_dot^T G a_dot,
+
+i.e. ``M_rot(q) a`` plus velocity-quadratic (gyroscopic) terms. Because the
+semi-discrete equations derive from the Lagrangian ``T - U`` (both evaluated
+with the same quadrature rules), ``d/dt (T + U) = v . f_ext``: the model
+conserves energy between director updates. The Jacobian blocks need ``H =
+d2g/da2`` and are exact (jets).
+
+Director update
+---------------
+After an accepted step (chapter Sect. 3.6), per global node with slope ``a``,
+angle ``theta`` and director ``d``:
+
+* ``"projected"``: ``d <- e30`` (Eq. 99 at the node), ``theta`` unchanged;
+* ``"post-rotated"``: ``d <- e3`` and ``theta <- 0``;
+* ``"none"``: no update.
+
+Either update leaves the nodal frame unchanged, and sets ``theta_dot`` to the
+node's physical spin ``omega1`` (with the new director ``d . e1 = 0``, hence
+``g = 0``), so nodal positions, slopes, frames and spins are unchanged, and a
+second update right after the first changes nothing. Inside an element the
+frame depends on the *interpolated* director, so an update changes the
+interior frames, the strain and the kinetic energy: by O(h^2) (h the element
+length) for a given deformed state, and not at all for motions in the plane
+normal to the director. This cannot be avoided with the chapter's linear
+interpolation of directors and angle.
+
+Consequence for dynamics (chapter Sect. 5.3): between updates the equations
+conserve ``T + U``; every update adds a jump. With an update after every
+time step the jumps accumulate at a rate independent of the step size, and
+they grow when neighbouring nodal directors drift apart (the projected
+directors by the holonomy of each node's tangent path, the post-rotated ones
+by the physical twist and bending between nodes), because their linear
+interpolation then shrinks towards zero and the interior frames turn fast.
+This is the energy blow-up of BE3D; without updates the energy stays
+conserved until the axis meets the fixed director (Eq. 99 singular).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ._be3d_kinematics import director_field, frames, spin_coefficients, spin_gradient
+
+__all__ = ["rotary_inertia", "rotary_kinetic_energy", "update_directors", "UPDATES"]
+
+UPDATES = ("projected", "post-rotated", "none")
+
+# Below this sine of the angle between director and axis, a node's frame is undefined.
+_SINGULAR = 1e-12
+
+
+def _spin_parts(rule, geom, q, second):
+    a = np.einsum("epin,en->epi", rule.Ba, q)
+    d, _ = director_field(geom["directors"], rule)
+    if second:
+        gj = spin_coefficients(a, d, True)
+        g = np.stack([j.v for j in gj], axis=-1)              # (n_el, n_pts, 3)
+        G = np.stack([j.g for j in gj], axis=-2)              # (..., 3, 3): G[i, k] = dg_i/da_k
+        H = np.stack([j.h for j in gj], axis=-3)              # (..., 3, 3, 3)
+    else:
+        (g, G), H = spin_gradient(a, d), None
+    w = rule.Nt + np.einsum("epin,epi->epn", rule.Ba, g)      # omega1 = w . v
+    return a, g, G, H, w
+
+
+def rotary_kinetic_energy(rule, geom, q, v, rhoJ):
+    """``1/2 int rho J omega1^2 dxi`` per element, shape (n_el,)."""
+    *_, w = _spin_parts(rule, geom, q, False)
+    om = np.einsum("epn,en->ep", w, v)
+    return 0.5 * rhoJ * np.sum(rule.wdx * om**2, axis=1)
+
+
+def rotary_inertia(rule, geom, q, v, acc, rhoJ, jacobian=True):
+    """Rotary inertia force ``f_rot`` and, if asked, ``df/dq``, ``df/dv``, ``df/da`` (module docstring)."""
+    a, g, G, H, w = _spin_parts(rule, geom, q, jacobian)
+    Ba = rule.Ba
+    ad = np.einsum("epin,en->epi", Ba, v)                     # a_dot
+    om = np.einsum("epn,en->ep", w, v)                        # omega1
+    Gad = np.einsum("...ik,...k->...i", G, ad)
+    Om = np.einsum("epn,en->ep", w, acc) + np.einsum("...i,...i", ad, Gad)
+    Aad = Gad - np.einsum("...ki,...k->...i", G, ad)          # (G - G^T) a_dot
+    c = np.einsum("epin,epi->epn", Ba, Aad)
+    W = rhoJ * rule.wdx
+    f = np.einsum("ep,epn->en", W, w * Om[..., None] + om[..., None] * c)
+    if not jacobian:
+        return f, None, None, None
+    outer = lambda x, y: x[..., :, None] * y[..., None, :]   # noqa: E731
+    Wm = W[..., None, None]
+    dfda = np.sum(Wm * outer(w, w), axis=1)
+    GGt = G + np.swapaxes(G, -1, -2)
+    GmGt = G - np.swapaxes(G, -1, -2)
+    BaT = np.swapaxes(Ba, -1, -2)
+    sym = np.einsum("epin,epi->epn", Ba, np.einsum("...ik,...k->...i", GGt, ad))
+    dfdv = np.sum(Wm * (outer(w, sym) + outer(c, w) + om[..., None, None] * (BaT @ GmGt @ Ba)), axis=1)
+    add = np.einsum("epin,en->epi", Ba, acc)                  # a_ddot
+    T1 = np.einsum("...i,...ijk,...j->...k", ad, H, ad)
+    dOm = np.einsum("epin,epi->epn", Ba, np.einsum("...ik,...i->...k", G, add) + T1)
+    dom = np.einsum("epin,epi->epn", Ba, np.einsum("...ik,...i->...k", G, ad))
+    A2 = np.einsum("...ijk,...j->...ik", H, ad) - np.einsum("...jik,...j->...ik", H, ad)
+    dfdq = np.sum(Wm * ((BaT @ G @ Ba) * Om[..., None, None] + outer(w, dOm) + outer(c, dom)
+                        + om[..., None, None] * (BaT @ A2 @ Ba)), axis=1)
+    return f, dfdq, dfdv, dfda
+
+
+def update_directors(geom, Q, V, variant):
+    """Apply the director update in place on ``geom["directors"]``; return the new ``(Q, V)``.
+
+    ``Q``, ``V``: nodal coordinates and velocities, shape (n_nodes, 7),
+    per node ``(x, y, z, x', y', z', theta)``.
+    """
+    if variant == "none":
+        return Q, V
+    D = geom["directors"]
+    a = Q[:, 3:6]
+    with np.errstate(invalid="ignore", divide="ignore"):   # a singular node is reported below
+        F, n = frames(a, Q[:, 6], D)
+    bad = np.flatnonzero(~(n > _SINGULAR))
+    if bad.size:
+        raise FloatingPointError(
+            f"BE3D director update: the director is parallel to the beam axis at node(s) {bad.tolist()} "
+            "(the projection of chapter Eq. 99 is singular); use smaller steps so the update follows the axis.")
+    g, _ = spin_gradient(a, D)
+    omega1 = V[:, 6] + np.einsum("ni,ni->n", g, V[:, 3:6])
+    Q, V = Q.copy(), V.copy()
+    if variant == "projected":
+        # e30 (Eq. 99): turn e3 back by theta, since e3 = c e30 - s e20 and e2 = c e20 + s e30.
+        c, s = np.cos(Q[:, 6])[:, None], np.sin(Q[:, 6])[:, None]
+        D[:] = c * F[:, :, 2] + s * F[:, :, 1]
+    else:
+        D[:] = F[:, :, 2]
+        Q[:, 6] = 0.0
+    V[:, 6] = omega1
+    return Q, V

@@ -1,0 +1,214 @@
+"""Point kinematics of BE3D: cross-section frame, curvature and twist, spin about the axis.
+
+Everything is written in the slope ``a = r'`` and its derivative ``b = r''``
+(per the element coordinate xi), the torsion angle ``theta`` and its
+derivative ``theta'``, and the interpolated director ``d`` with its
+derivative ``d'`` (chapter Sect. 3.6, linear in xi, constant between director
+updates). With ``p = a.a``, ``m = d x a``, ``m2 = |m|^2``:
+
+* Frame (Eqs. 96-100): ``e1 = a/|a|``, ``e20 = m/|m|``,
+  ``e30 = e1 x e20 = (p d - (a.d) a) / (|a| |m|)``, and ``e2, e3`` turned by
+  ``theta`` about ``e1`` (Eqs. 97-98).
+* Curvature vector components ``k_i`` along ``e_i`` (Eqs. 18-20, per xi)::
+
+      k1 = e2'.e3 = theta' - tau0,   tau0 = (p d'.m - (a.d) b.m) / (|a| m2)
+      k2 = e3'.e1 = s X - c Y,       k3 = e1'.e2 = c X + s Y,
+      X  = b.e20 / |a| = b.m / (|a| |m|),
+      Y  = b.e30 / |a| = (p b.d - (a.b)(a.d)) / (p |m|),   c, s = cos, sin theta.
+
+  ``tau0`` is the twist of the director frame ``(e1, e20, e30)``; ``k1`` has
+  no shear part because ``e1`` follows ``r'`` (zero shear, Sect. 3.5).
+* Spin about the axis (``omega . e1``, the same formula with time instead of
+  xi and ``d' -> d_dot = 0``)::
+
+      omega1 = theta_dot + g(a) . a_dot,   g(a) = (a.d) m / (|a| m2).
+
+All quantities are returned as :class:`~ancfdae.models._scalar_jet.Jet` objects with
+exact derivatives with respect to the local variables.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ._scalar_jet import Jet
+
+__all__ = ["curvatures", "curvature_energy", "spin_coefficients", "spin_gradient", "frames", "director_field",
+           "cross", "EPS"]
+
+# Levi-Civita symbol: (u x v)_i = EPS[i, j, k] u_j v_k
+EPS = np.zeros((3, 3, 3))
+EPS[0, 1, 2] = EPS[1, 2, 0] = EPS[2, 0, 1] = 1.0
+EPS[0, 2, 1] = EPS[2, 1, 0] = EPS[1, 0, 2] = -1.0
+
+
+def cross(u, v):
+    """``u x v`` over the last axis (np.cross costs several times more on small batches)."""
+    u0, u1, u2 = u[..., 0], u[..., 1], u[..., 2]
+    v0, v1, v2 = v[..., 0], v[..., 1], v[..., 2]
+    return np.stack([u1 * v2 - u2 * v1, u2 * v0 - u0 * v2, u0 * v1 - u1 * v0], axis=-1)
+
+
+def _dot(u, v):
+    return u[..., 0] * v[..., 0] + u[..., 1] * v[..., 1] + u[..., 2] * v[..., 2]
+
+
+def _jet(v, n, second, grads, hess=()):
+    """Build a jet from its value and sparse gradient/Hessian blocks ``(slice, array)``."""
+    g = np.zeros(v.shape + (n,))
+    for sl, val in grads:
+        g[..., sl] = val
+    h = None
+    if second:
+        h = np.zeros(v.shape + (n, n))
+        for (si, sj), val in hess:
+            h[..., si, sj] = val
+    return Jet(v, g, h)
+
+
+def _invariants(a, b, d, dp, n, second, with_b=True):
+    """Polynomial invariants as jets over ``(a[, b, theta, theta'])`` (variables a: 0:3, b: 3:6)."""
+    A, B = slice(0, 3), slice(3, 6)
+    I = np.eye(3)
+    dot = _dot
+    dd = dot(d, d)
+    ad = dot(a, d)
+    m = cross(d, a)
+    out = {
+        "p": _jet(dot(a, a), n, second, [(A, 2.0 * a)], [((A, A), 2.0 * I)]),
+        "ad": _jet(ad, n, second, [(A, d)]),
+        "m2": _jet(dot(m, m), n, second, [(A, 2.0 * (dd[..., None] * a - ad[..., None] * d))],
+                   [((A, A), 2.0 * (dd[..., None, None] * I - d[..., :, None] * d[..., None, :]))]),
+    }
+    if with_b:
+        # b.(d x a) = a.(b x d); d2/(da_i db_j) = (e_j x d)_i = EPS[i, j, k] d_k
+        Hab = np.einsum("ijk,...k->...ij", EPS, d)
+        out["ab"] = _jet(dot(a, b), n, second, [(A, b), (B, a)], [((A, B), I), ((B, A), I)])
+        out["bd"] = _jet(dot(b, d), n, second, [(B, d)])
+        out["t"] = _jet(dot(b, m), n, second, [(A, cross(b, d)), (B, m)],
+                        [((A, B), Hab), ((B, A), np.swapaxes(Hab, -1, -2))])
+        out["tp"] = _jet(dot(dp, m), n, second, [(A, cross(dp, d))])
+    return out
+
+
+def curvatures(a, b, theta, dtheta, d, dp, second=True):
+    """Twist and curvatures ``(k1, k2, k3)`` per xi as jets over ``(a, b, theta, theta')`` (8 variables).
+
+    Parameters
+    ----------
+    a, b : (..., 3) slope ``r'`` and ``r''``; theta, dtheta : (...,) angle and
+    its xi-derivative; d, dp : (..., 3) director and its xi-derivative.
+    """
+    n = 8
+    inv = _invariants(a, b, d, dp, n, second)
+    p, ad, m2, ab, bd, t, tp = (inv[k] for k in ("p", "ad", "m2", "ab", "bd", "t", "tp"))
+    th = _jet(theta, n, second, [(6, 1.0)])
+    thp = _jet(dtheta, n, second, [(7, 1.0)])
+    sp = p.sqrt()
+    sm = m2.sqrt()
+    X = t / (sm * sp)
+    Y = (bd * p - ab * ad) / (p * sm)
+    tau0 = (p * tp - ad * t) / (sp * m2)
+    c, s = th.cos(), th.sin()
+    return thp - tau0, s * X - c * Y, c * X + s * Y
+
+
+def curvature_energy(a, b, theta, dtheta, d, dp, k_ref, D):
+    """Bending-torsion energy density and its gradient, by the chain rule written out (residual path).
+
+    ``W = 1/2 sum_i D_i (k_i - k_ref_i)^2`` with the ``k_i`` of
+    :func:`curvatures`; the gradient is with respect to ``(a, b, theta,
+    theta')``, shape (..., 8). Same values as the jets of :func:`curvatures`
+    (the tests compare the two), a few times fewer array operations.
+    """
+    dot = _dot
+    p, ad, ab, bd = dot(a, a), dot(a, d), dot(a, b), dot(b, d)
+    m = cross(d, a)
+    m2, t, tp = dot(m, m), dot(b, m), dot(dp, m)
+    sp, sm = np.sqrt(p), np.sqrt(m2)
+    X = t / (sm * sp)
+    Yn = bd * p - ab * ad
+    Y = Yn / (p * sm)
+    tau0 = (p * tp - ad * t) / (sp * m2)
+    c, s = np.cos(theta), np.sin(theta)
+    k1, k2, k3 = dtheta - tau0, s * X - c * Y, c * X + s * Y
+    r1, r2, r3 = (D[0] * (k1 - k_ref[..., 0]), D[1] * (k2 - k_ref[..., 1]), D[2] * (k3 - k_ref[..., 2]))
+    W = 0.5 * (r1 * (k1 - k_ref[..., 0]) + r2 * (k2 - k_ref[..., 1]) + r3 * (k3 - k_ref[..., 2]))
+    WX, WY, Wtau = r3 * c + r2 * s, r3 * s - r2 * c, -r1
+    # partial derivatives of W through X, Y, tau0 with respect to the invariants
+    W_t = WX / (sm * sp) - Wtau * ad / (sp * m2)
+    W_p = -WX * X / (2 * p) + WY * (bd / (p * sm) - Y / p) + Wtau * (tp / (sp * m2) - tau0 / (2 * p))
+    W_m2 = -(WX * X + WY * Y) / (2 * m2) - Wtau * tau0 / m2
+    W_ad = -WY * ab / (p * sm) - Wtau * t / (sp * m2)
+    W_ab = -WY * ad / (p * sm)
+    W_bd = WY / sm
+    W_tp = Wtau * sp / m2
+    dd = dot(d, d)
+    e = lambda x: x[..., None]   # noqa: E731
+    ga = (e(2 * W_p + 2 * dd * W_m2) * a + e(W_ad - 2 * ad * W_m2) * d + e(W_ab) * b
+          + e(W_t) * cross(b, d) + e(W_tp) * cross(dp, d))
+    gb = e(W_ab) * a + e(W_bd) * d + e(W_t) * m
+    grad = np.concatenate([ga, gb, e(r2 * k3 - r3 * k2), e(r1)], axis=-1)
+    return W, grad
+
+
+def spin_gradient(a, d):
+    """``g(a)`` of :func:`spin_coefficients` and ``G = dg/da`` (shape (..., 3, 3)) without jets."""
+    dot = _dot
+    p, ad = dot(a, a), dot(a, d)
+    m = cross(d, a)
+    m2 = dot(m, m)
+    sp = np.sqrt(p)
+    coef = ad / (sp * m2)
+    dcoef = (d / (sp * m2)[..., None] - (coef / p)[..., None] * a
+             - (coef / m2)[..., None] * (2 * dot(d, d)[..., None] * a - 2 * ad[..., None] * d))
+    dm = np.einsum("jlk,...l->...jk", EPS, d)
+    g = coef[..., None] * m
+    G = coef[..., None, None] * dm + m[..., :, None] * dcoef[..., None, :]
+    return g, G
+
+
+def spin_coefficients(a, d, second=True):
+    """The vector ``g(a) = (a.d)(d x a) / (|a| |d x a|^2)`` of ``omega1 = theta_dot + g . a_dot``.
+
+    Returns three jets over ``a`` (3 variables): ``G = dg/da`` are their
+    gradients and ``H = d2g/da2`` their Hessians.
+    """
+    inv = _invariants(a, None, d, None, 3, second, with_b=False)
+    p, ad, m2 = inv["p"], inv["ad"], inv["m2"]
+    coef = ad / (p.sqrt() * m2)
+    m = cross(d, a)
+    # d(d x a)_j / da_k = EPS[j, l, k] d_l
+    dm = np.einsum("jlk,...l->...jk", EPS, d)
+    zero = np.zeros(a.shape[:-1] + (3, 3)) if second else None
+    return [coef * Jet(m[..., j], dm[..., j, :], zero) for j in range(3)]
+
+
+def frames(a, theta, d):
+    """Cross-section frames (Eqs. 96-100), shape (..., 3, 3) with columns ``(e1, e2, e3)``.
+
+    Also returns ``n = |d x e1| / |d|``, the sine of the angle between
+    director and axis (the projection of Eq. 99 is singular at ``n = 0``).
+    """
+    e1 = a / np.linalg.norm(a, axis=-1, keepdims=True)
+    u = cross(d, e1)
+    nu = np.linalg.norm(u, axis=-1, keepdims=True)
+    e20 = u / nu
+    e30 = cross(e1, e20)
+    c, s = np.cos(theta)[..., None], np.sin(theta)[..., None]
+    e2 = c * e20 + s * e30
+    e3 = c * e30 - s * e20
+    return np.stack([e1, e2, e3], axis=-1), nu[..., 0] / np.linalg.norm(d, axis=-1)
+
+
+def director_field(directors, rule):
+    """Director ``d = S5 d_A + S6 d_B`` and ``d' = (d_B - d_A) / L`` at a rule's points (Sect. 3.6).
+
+    ``directors`` has shape (n_el + 1, 3) (global nodes along the beam);
+    ``rule.lin`` holds ``(S5, S6)`` at the points, shape (n_pts, 2), and
+    ``rule.L`` the element lengths. Returns ``d`` (n_el, n_pts, 3) and
+    ``d'`` (n_el, 1, 3).
+    """
+    dA, dB = directors[:-1], directors[1:]
+    d = rule.lin[None, :, 0, None] * dA[:, None, :] + rule.lin[None, :, 1, None] * dB[:, None, :]
+    dp = ((dB - dA) / rule.L[:, None])[:, None, :]
+    return d, dp

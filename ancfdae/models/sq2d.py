@@ -1,0 +1,77 @@
+"""SQ2D: the planar shear- and cross-section-deformable ANCF beam element (chapter Sect. 4).
+
+Per node the position and the cross-section slope, ``(x, y, x_eta, y_eta)``
+(gradient-deficient, Eq. 57 without ``x_zeta``); quadratic three-node
+interpolation (Eq. 105, 12 DOF) by default, linear two-node (Eq. 104, 8 DOF)
+as an option.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ._jet import combine, linear, mul, recip, sqrt, dot, variables
+from ._sq_common import SQElement
+
+__all__ = ["SQ2D"]
+
+# e_1 = (e_2y, -e_2x): e_2 turned by -90 degrees, so that (e_1, e_2, e_z) is right-handed.
+_TURN = np.array([[0.0, 1.0], [-1.0, 0.0]])
+
+
+class SQ2D(SQElement):
+    """Planar shear- and cross-section-deformable ANCF beam element (chapter Sect. 4).
+
+    Parameters
+    ----------
+    material : Material
+    section : RectangularSection or CircularSection
+        Structural: ``A``, ``I3`` (in-plane bending), ``k_s(material)``.
+    formulation : {"structural", "continuum", "continuum-locking"}
+        ``"structural"`` (Sect. 4.2.2): the frame of the cross-section slope,
+        ``e_2 = a/|a|``, ``e_1 = e_2 x e_z`` with ``a = x_eta`` (the planar
+        analogue of Eq. 7); generalised strains ``Gamma_1 = e_1.r' - 1``,
+        ``Gamma_2 = e_2.r'`` (Eq. 16), curvature ``kappa = (a x a').e_z/|a|^2``
+        (Eqs. 19, 25) and thickness strain ``E_22 = (a.a - 1)/2`` (Eq. 50), with
+        ``U = 1/2 int EA Gamma_1^2 + k_s GA Gamma_2^2 + EI kappa^2 + EA E_22^2
+        dxi`` (Eqs. 109, 110).
+        ``"continuum"`` (Sect. 4.2.1): Green strain and St. Venant-Kirchhoff,
+        plane stress, shear with ``k_s``, with the Poisson-locking remedy of
+        Eq. 108 (Poisson part on the axis only). ``"continuum-locking"``: the
+        same without the remedy (Poisson locking in bending).
+    nodes : {3, 2}
+        Quadratic (default, Eq. 105) or linear (Eq. 104) interpolation.
+    quadrature : dict, optional
+        Override of :meth:`default_quadrature`: structural terms ``"axial"``,
+        ``"shear"``, ``"bending"``, ``"cross_section"``; continuum ``"axial"``,
+        ``"section"``; each a number of Gauss points or
+        ``("gauss"|"lobatto", n)``.
+    """
+
+    name = "SQ2D"
+    dim = 2
+    node_coordinates = ("x", "y", "x_eta", "y_eta")
+    _terms = ("axial", "shear", "bending", "cross_section")
+
+    def _stiffness(self):
+        m, s = self.material, self.section
+        return np.array([m.E * s.A, s.k_s(m) * m.G * s.A, m.E * s.I3, m.E * s.A])
+
+    @staticmethod
+    def _strains(p, which):
+        """``(terms, s)`` of Gamma_1, Gamma_2, kappa, E_22 (those in ``which``); blocks 0 = r', 1 = a'."""
+        a = p[0]
+        aa = dot(a, a)
+        out = {3: ([], combine([np.full(aa.v.shape, 0.5)], [aa]))}
+        if any(k < 3 for k in which):
+            e2 = mul(recip(sqrt(aa)), a)
+            # (a x a').e_z / |a|^2 = a' . (-TURN a) / |a|^2
+            out.update({0: ([(0, linear(_TURN, e2))], None), 1: ([(0, e2)], None),
+                        2: ([(1, mul(recip(aa), linear(-_TURN, a)))], None)})
+        return [out[k] for k in which]
+
+    def _rotation_force(self, p, moment):
+        """Planar dead moment: ``delta phi = (a x delta a).e_z / |a|^2`` of the slope ``a = x_eta``."""
+        (a,) = variables(p[None, :])
+        g = mul(recip(dot(a, a)), linear(-_TURN, a))
+        Mz = float(moment[2])
+        return Mz * g.v[0], Mz * g.g[0]
