@@ -260,6 +260,8 @@ class LobattoIIIA(FixedStepIntegrator):
         Q, V_ = Q0 + X @ CQ, V0 + X @ CV
         if self.predictor == "extrapolate":
             self._prev = (h, np.column_stack([self.a, X]))
-        nodes = (np.r_[t, ts], np.column_stack([self.q, Q]).T, np.column_stack([self.v, V_]).T,
-                 h * self.tableau.b)
+        nodes = None
+        if self.want_nodes:  # the step's Lobatto quadrature, for monitors that integrate over it
+            nodes = (np.r_[t, ts], np.column_stack([self.q, Q]).T, np.column_stack([self.v, V_]).T,
+                     h * self.tableau.b)
         return True, (Q[:, -1].copy(), V_[:, -1].copy(), X[:, -1].copy(), nodes)
