@@ -123,7 +123,11 @@ class IDA:
     atol : float, (atol_q, atol_v) or array of length 2 n_dof, optional
         Absolute tolerance. Default ``(rtol * L, rtol * L / (tf - t0))`` with
         ``L = max(1, max|q0|)``: positions and slopes on the scale of the
-        configuration, velocities on that scale per run time.
+        configuration, velocities on that scale per run time. The velocity
+        tolerance decides the cost on stiff beams: on the 25-element BE2D
+        pendulum (0.2 s, rtol 1e-6) the default resolved the axial
+        vibrations (8,903 steps, tip error 8e-7) while ``atol=(1e-6, 1e-2)``
+        took 217 steps (tip error 1.5e-4) -- measured.
     max_order : int in [1, 5], optional
         BDF order limit. Default 2 when the damping block ``D`` at t0 is zero
         (undamped: orders 3-5 are not A-stable and force tiny steps), else 5.
