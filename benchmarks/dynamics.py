@@ -49,9 +49,13 @@ METHODS = {
 }
 
 
+#: BE2D kernel option ("auto": numba when importable); set by --kernel
+KERNEL = "auto"
+
+
 def pendulum(n_elements: int, free: bool = False) -> Beam:
     """The flexible pendulum (hinged, gravity) or its free-flying variant as a Beam of BE2D."""
-    el = BE2D(Material(**MATERIAL), RectangularSection(SIDE))
+    el = BE2D(Material(**MATERIAL), RectangularSection(SIDE), kernel=KERNEL)
     if free:
         return Beam(el, n_elements=n_elements, length=1.0,
                     initial_velocity=lambda p: np.column_stack([0 * p[:, 0], 2 * np.sin(np.pi * p[:, 0])]))
@@ -76,6 +80,12 @@ class _Timed:
     def residual(self, *args):
         t0 = time.perf_counter()
         r = self.m.residual(*args)
+        self.t_res += time.perf_counter() - t0
+        return r
+
+    def residual_stages(self, *args):
+        t0 = time.perf_counter()
+        r = self.m.residual_stages(*args)
         self.t_res += time.perf_counter() - t0
         return r
 
@@ -188,12 +198,16 @@ def main(argv=None):
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--methods", nargs="+", default=list(METHODS), choices=list(METHODS))
     ap.add_argument("--no-free", action="store_true", help="skip the free-flying variant")
+    ap.add_argument("--kernel", default="auto", choices=["auto", "numpy", "numba"], help="BE2D kernel option")
     ap.add_argument("--profile", action="store_true", help="one extra run per integrator, timing its parts")
     a = ap.parse_args(argv)
     if peer is None or not peer.available():
         print("exudyn not importable: printing ancfdae only (pip install '.[benchmark]')")
     else:
         print(f"exudyn module: {peer.module_variant()}")
+    global KERNEL
+    KERNEL = a.kernel
+    print(f"BE2D kernel: {a.kernel} -> {pendulum(1).element.kernel_in_use}")
     for n in a.elements:
         run_case(n, False, a.methods, a.t_end, a.h, a.tol, a.repeats, a.profile)
     if not a.no_free:

@@ -48,3 +48,22 @@ def test_auto_kernel_follows_numba_availability(monkeypatch):
 def test_unknown_kernel_is_rejected():
     with pytest.raises(ValueError, match="kernel"):
         BE2D(Material(2.1e11, 0.3, 7800.0), RectangularSection(0.1), kernel="fortran")
+
+
+@pytest.mark.parametrize("kernel", ["numpy", "numba"])
+def test_residual_stages_equal_per_stage_residuals(kernel):
+    if kernel == "numba":
+        pytest.importorskip("numba")
+    from ancfdae import Gravity, PointForce, PointMoment
+    beam = Beam(BE2D(Material(2.1e11, 0.3, 7800.0), RectangularSection(0.1), kernel=kernel), 5, 2.0,
+                supports={0: "clamp"}, loads=[PointForce((1e5, 2e5), s=1.3, time=lambda t: 1.0 + t),
+                                              PointMoment(3e5, node=-1), Gravity((0.0, -9.81))])
+    rng = np.random.default_rng(4)
+    n = beam.n_dof
+    ts = np.array([0.1, 0.7, 0.9])
+    Q = beam.initial_state()[0][:, None] + 0.01 * rng.standard_normal((n, 3))
+    V, A = rng.standard_normal((n, 3)), rng.standard_normal((n, 3))
+    R = beam.residual_stages(ts, Q, V, A)
+    R0 = np.column_stack([beam.residual(ts[i], Q[:, i], V[:, i], A[:, i]) for i in range(3)])
+    assert R.shape == (n, 3)
+    assert np.abs(R - R0).max() <= 1e-14 * np.abs(R0).max()

@@ -21,7 +21,9 @@ the band structure of the model's matrices, has the blocks::
 
     dr_i / dA_k = delta_ik M_i + h a_ik D_i + h^2 (a^2)_ik K_i
 
-with ``K_i, D_i, M_i`` the exact Jacobian blocks at stage ``i``.
+with ``K_i, D_i, M_i`` the exact Jacobian blocks at stage ``i``. A model with the optional
+method ``residual_stages(ts, Q, V, A) -> R`` (columns = stages, e.g. :class:`~ancfdae.models.Beam`)
+has all implicit stages' residuals evaluated in one call; otherwise one ``residual`` call per stage.
 """
 from __future__ import annotations
 
@@ -237,9 +239,14 @@ class LobattoIIIA(FixedStepIntegrator):
                 self._set_floor(blk, qs)
                 return self._matrix([blk], h)
         else:
+            stages = getattr(self.model, "residual_stages", None)
+
             def residual(x):
                 X = x.reshape(n, m)
                 Q, V_ = Q0 + X @ CQ, V0 + X @ CV
+                if stages is not None:   # all stages in one model call (optional Model method)
+                    self._n_res += m
+                    return stages(ts, Q, V_, X).ravel()
                 R = np.empty((n, m))
                 for i in range(m):
                     R[:, i] = self._residual(ts[i], Q[:, i], V_[:, i], X[:, i])
