@@ -335,14 +335,19 @@ class Beam:
         m = ts.size
         if not self.mass_is_constant:
             return np.column_stack([self.residual(ts[i], Q[:, i], V[:, i], A[:, i]) for i in range(m)])
-        geom, idx = self._stage_geometry(m)
-        ext = np.concatenate((Q.T, np.broadcast_to(self._q_fixed, (m, self._q_fixed.size))), axis=1)
-        fe, _ = self.element.internal_forces(geom, ext[:, self._gather].reshape(-1, self._gather.shape[1]), False)
+        geom, gather, idx = self._stage_geometry(m)
         n = self.n_dof
+        ext = np.empty((n + self._q_fixed.size, m))   # (free q; fixed values) per stage, stage fastest
+        ext[:n] = Q
+        ext[n:] = self._q_fixed[:, None]
+        fe, _ = self.element.internal_forces(geom, ext.ravel().take(gather), False)
         F = np.bincount(idx, weights=fe.ravel(), minlength=m * (n + 1)).reshape(m, n + 1)[:, :n].T
         R = F + self._M_csr @ A
-        for i in range(m):
-            R[:, i] -= self.load_factor * self._f_external(ts[i], Q[:, i], False)[0]
+        if not self._dead and not self._moments:
+            R -= self.load_factor * self._f_gravity[:, None]
+        else:
+            for i in range(m):
+                R[:, i] -= self.load_factor * self._f_external(ts[i], Q[:, i], False)[0]
         return R
 
     def _stage_geometry(self, m):
@@ -353,7 +358,8 @@ class Beam:
             geom = self.element.prepare(np.tile(q_ref_e, (m, 1)), np.tile(self.lengths, m))
             vec_all = self._asm._vec_all
             idx = (np.arange(m)[:, None] * (self.n_dof + 1) + vec_all[None, :]).ravel()
-            cache[m] = (geom, idx)
+            gather = (self._gather[None] * m + np.arange(m)[:, None, None]).reshape(-1, self._gather.shape[1])
+            cache[m] = (geom, gather, idx)
         return cache[m]
 
     def residual_jacobian(self, t, q, v, a):
