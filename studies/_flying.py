@@ -1,0 +1,179 @@
+"""The free flying beams of benchmarks B2 and B3 (chapter Sects. 5.2, 5.3) and their shared tools.
+
+Both beams (benchmarks.md): L = 1 m, square section a = 0.05 m, E = 1e5 N/m^2,
+nu = 0.3, rho = 2500 kg/m^3 (chapter Eq. 114), free-free, straight and at
+rest along ``r(s) = s (0.6, 0.8[, 0])``; B is the end s = 0.
+
+* B2 (in plane): dead force ``f(t) (0.8, 0) N`` and moment ``f(t) 0.8 N m``
+  about +e_z at B, pulse ``f(t) = (1 - cos(2 pi t / T_p)) / 2`` for
+  ``t <= T_p = 2.5 s``, 0 after.
+* B3 (in space): dead moment ``f(t) (0.4, 0.2, 0.8) N m`` at B with the hat
+  ``f(t) = t/1.5`` up to 1.5 s, down to 0 at 3 s.
+
+:func:`simulate_case` runs one case and returns a small picklable dict
+(tip history, energy log, work counters, CPU time), so that sweeps can run in
+worker processes (:func:`studies._common.run_cases`). :func:`eps_T` is the
+integrated tip error of chapter Eq. 115.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from ancfdae import Material, PointForce, PointMoment, RectangularSection, hat, pulse
+from ancfdae import models
+from ancfdae.integrators import NewtonOptions
+from ancfdae.monitors import EnergyMonitor, PointSensor
+from ancfdae.simulate import simulate
+
+__all__ = ["Case", "MATERIAL", "SECTION", "LENGTH", "T_PULSE", "T_HAT", "FAMILY", "available", "b2_beam", "b3_beam",
+           "simulate_case", "eps_T", "regress_order", "steady_drift"]
+
+MATERIAL = Material(E=1e5, nu=0.3, rho=2500.0)
+SECTION = RectangularSection(0.05)
+LENGTH = 1.0
+T_PULSE = 2.5      # B2: end of the load pulse (s)
+T_HAT = 3.0        # B3: end of the moment hat (s)
+
+#: element type -> family whose 128-element solution is the reference (chapter Sect. 5.2:
+#: "different for thin and for shear deformable beams").
+FAMILY = {"BE2D": "BE", "BE3D": "BE", "SQ2D": "SQ", "SQ3D": "SQ"}
+
+
+class Case(dict):
+    """A sweep case: a dict of options whose ``str`` is its ``label`` (shown by the progress line)."""
+
+    def __str__(self):
+        return str(self.get("label", dict.__repr__(self)))
+
+
+def available(names) -> list[str]:
+    """The element types of ``names`` that ancfdae.models provides."""
+    return [n for n in names if hasattr(models, n)]
+
+
+def _element(name, E_scale=1.0, **options):
+    if not hasattr(models, name):
+        raise ValueError(f"`element` must be one of {available(FAMILY)}, got {name!r}.")
+    mat = MATERIAL if E_scale == 1.0 else Material(E=MATERIAL.E * E_scale, nu=MATERIAL.nu, rho=MATERIAL.rho)
+    return getattr(models, name)(mat, SECTION, **options)
+
+
+def b2_beam(name: str, n_elements: int, E_scale: float = 1.0, **element_options):
+    """B2, the beam flying in plane; 3D element types move in the plane z = 0.
+
+    ``E_scale`` multiplies Young's modulus (a stiffer variant for the
+    integrator study).
+    """
+    el = _element(name, E_scale, **element_options)
+    f = pulse(T_PULSE)
+    if el.dim == 2:
+        kw, F, M = dict(start=(0.0, 0.0), direction=(0.6, 0.8)), (0.8, 0.0), 0.8
+    else:
+        kw, F, M = dict(start=(0.0, 0.0, 0.0), direction=(0.6, 0.8, 0.0)), (0.8, 0.0, 0.0), (0.0, 0.0, 0.8)
+    return models.Beam(el, n_elements, LENGTH, loads=[PointForce(F, node=0, time=f), PointMoment(M, node=0, time=f)],
+                       **kw)
+
+
+def b3_beam(name: str, n_elements: int, t_load: float = T_HAT, scale: float = 1.0, **element_options):
+    """B3, the beam flying in space (3D element types only).
+
+    ``t_load`` (end of the hat, benchmarks.md: 3 s) and ``scale`` (of the
+    moment) give the shorter, gentler variant of the quick modes.
+    """
+    el = _element(name, **element_options)
+    if el.dim != 3:
+        raise ValueError(f"`element` of B3 must be a spatial type, got {name!r}.")
+    moment = scale * np.array([0.4, 0.2, 0.8])
+    return models.Beam(el, n_elements, LENGTH, start=(0.0, 0.0, 0.0), direction=(0.6, 0.8, 0.0),
+                       loads=[PointMoment(moment, node=0, time=hat(t_load / 2))])
+
+
+def simulate_case(beam, t_end: float, method: str = "lobatto3", h: float | None = 1e-3, dt_out: float = 0.01,
+                  newton: dict | None = None, energy: bool = True, stop_on_blowup: bool = False,
+                  **options) -> dict:
+    """Integrate ``beam`` over ``[0, t_end]``; return a compact record of the run.
+
+    Parameters
+    ----------
+    beam : Beam
+    t_end : float
+    method, h, **options
+        Passed to :func:`ancfdae.simulate` (``h`` must be None for IDA).
+    dt_out : float
+        Output interval of the tip position and the energy log (a multiple of
+        ``h`` keeps the samples on the step grid, without interpolation).
+    newton : dict, optional
+        :class:`NewtonOptions` fields; default modified Newton, tol 1e-8
+        (chapter Sect. 5.2).
+    energy : bool
+        Log the energy balance (costs a few external-power evaluations per step).
+    stop_on_blowup : bool
+        End the run when the energy monitor flags a blow-up (10 % drift).
+
+    Returns
+    -------
+    dict
+        ``t``, ``tip`` (position of B, (n_out, dim)), ``energy`` (dict of
+        arrays ``kinetic``, ``strain``, ``work``, ``total``, ``balance``) or
+        None, ``stats``, ``cpu`` (process seconds), ``wall``, ``status``,
+        ``message``, ``t_fail``, ``dof``.
+    """
+    n_out = int(round(t_end / dt_out))
+    t_eval = np.linspace(0.0, n_out * dt_out, n_out + 1)
+    t_eval = t_eval[t_eval <= t_end * (1 + 1e-12)]
+    monitors = [PointSensor(s=0.0, name="tip")]
+    if energy:
+        monitors.append(EnergyMonitor(stop_on_blowup=stop_on_blowup))
+    if method != "ida":
+        options["newton"] = NewtonOptions(**({"tol": 1e-8, "jacobian": "modified"} | (newton or {})))
+    c0, w0 = time.process_time(), time.perf_counter()
+    res = simulate(beam, (0.0, t_end), method=method, h=h, t_eval=t_eval, monitors=monitors, **options)
+    cpu, wall = time.process_time() - c0, time.perf_counter() - w0
+    en = None
+    if energy:
+        log = res.monitors["energy"]
+        en = {k: np.asarray(log[k]) for k in ("kinetic", "strain", "work", "total", "balance")}
+        en["t_blow_up"] = log["t_blow_up"]
+    return {"t": res.t.copy(), "tip": np.asarray(res.monitors["tip"]["position"]), "energy": en,
+            "stats": dict(res.stats), "cpu": cpu, "wall": wall, "status": res.status, "message": res.message,
+            "t_fail": res.t_fail, "dof": int(beam.n_dof)}
+
+
+def eps_T(t, tip, t_ref, tip_ref) -> float:
+    """Integrated tip error of chapter Eq. 115, ``(int_0^T |u_ref - u|^2 dt)^(1/2)``.
+
+    The displacements share their initial position, so ``u_ref - u`` is the
+    difference of positions. The run's samples are matched to the reference's
+    by time (both on the same output grid); the integral is the trapezoidal
+    rule over the samples up to the end of the shorter of the two histories
+    (a failed run or reference ends early: compare ``t[-1]``). Only the first
+    two components are compared (3D types moving in the plane against a
+    planar reference lose nothing: their z stays 0).
+    """
+    t, t_ref = np.asarray(t), np.asarray(t_ref)
+    keep = t <= t_ref[-1] + 1e-9
+    t, tip = t[keep], np.asarray(tip)[keep]
+    idx = np.searchsorted(t_ref, t - 1e-9)
+    if t.size < 2 or np.any(np.abs(t_ref[np.minimum(idx, t_ref.size - 1)] - t) > 1e-9):
+        raise ValueError("`t` must be a subset of the reference's output times.")
+    d = tip[:, :2] - np.asarray(tip_ref)[idx, :2]
+    e2 = np.sum(d * d, axis=1)
+    return float(np.sqrt(np.sum(0.5 * (e2[1:] + e2[:-1]) * np.diff(t))))
+
+
+def regress_order(x, y) -> float:
+    """Observed order ``p`` of ``y ~ C x^-p`` by a least-squares line on log-log data."""
+    return float(-np.polyfit(np.log(np.asarray(x, float)), np.log(np.asarray(y, float)), 1)[0])
+
+
+def steady_drift(t, balance, t_from: float) -> dict:
+    """Energy drift after the load ends: max |E - E(t_from)| and the fitted rate dE/dt (per s)."""
+    t, balance = np.asarray(t), np.asarray(balance)
+    m = (t >= t_from - 1e-9) & np.isfinite(balance)
+    if m.sum() < 2:
+        return {"max": float("nan"), "rate": float("nan"), "final": float("nan")}
+    tb, eb = t[m], balance[m]
+    return {"max": float(np.max(np.abs(eb - eb[0]))), "rate": float(np.polyfit(tb, eb, 1)[0]),
+            "final": float(eb[-1] - eb[0])}

@@ -1,0 +1,168 @@
+"""Energy drift in long free motion: every element x integrator pair (design.md Sect. 1, chapter Sect. 5.3).
+
+The planar elements fly as in B2 (force and moment pulse, ends at 2.5 s), the
+spatial ones as in B3 (moment hat, ends at 3 s), both from benchmarks.md;
+after the load the motion is free and the total energy ``T + U`` of the exact
+solution is constant. Each element type is integrated by Lobatto IIIA (3 and
+2 stages, modified Newton), Newmark (beta 1/4, gamma 1/2), HHT (alpha 0.05),
+generalized-alpha (rho_inf 0.8) and IDA (BDF, max order 2), and the study
+records the balance ``E(t) = T + U - W_ext`` against time, the drift after the
+load (largest ``|E - E(t_load)|``, fitted rate dE/dt, relative to the energy
+at the end of the load), the time the energy monitor flags a blow-up (drift
+above 10 % of the energy scale; the run is stopped there) and the time a
+run fails (Newton divergence).
+
+Run: ``ancfdae study energy [--quick] [--out DIR] [--jobs N]``.
+"""
+from __future__ import annotations
+
+import os
+import pickle
+
+import numpy as np
+
+from ._common import Progress, markdown_table, output_dir, run_cases
+from ._flying import T_HAT, T_PULSE, Case, available, b2_beam, b3_beam, simulate_case, steady_drift
+
+__all__ = ["run", "run_case", "INTEGRATORS"]
+
+#: label -> (simulate method, options)
+INTEGRATORS = {
+    "lobatto3": ("lobatto3", {}),
+    "lobatto2": ("lobatto2", {}),
+    "newmark": ("newmark", {}),
+    "hht": ("hht", {"alpha": 0.05}),
+    "generalized-alpha": ("generalized-alpha", {"rho_inf": 0.8}),
+    "ida": ("ida", {"rtol": 1e-6}),
+}
+#: element -> (problem, elements)
+ELEMENTS = {"BE2D": ("B2", 4), "SQ2D": ("B2", 4), "BE3D": ("B3", 4), "SQ3D": ("B3", 4)}
+
+
+def run_case(case: dict) -> dict:
+    """One run: ``case = {element, n, problem, integrator, h, t_end, dt_out}``."""
+    os.environ.setdefault("OMP_NUM_THREADS", "1")
+    build = b2_beam if case["problem"] == "B2" else b3_beam
+    beam = build(case["element"], case["n"])
+    method, opts = INTEGRATORS[case["integrator"]]
+    h = None if method == "ida" else case["h"]
+    rec = simulate_case(beam, case["t_end"], method=method, h=h, dt_out=case["dt_out"], stop_on_blowup=True, **opts)
+    rec.update({k: case[k] for k in ("element", "n", "problem", "integrator", "h", "t_end", "label")})
+    return rec
+
+
+def summarize(rec: dict) -> dict:
+    """Drift after the load, blow-up and failure times of one run."""
+    t_load = T_PULSE if rec["problem"] == "B2" else T_HAT
+    t, en = rec["t"], rec["energy"]
+    k = np.searchsorted(t, t_load - 1e-9)
+    e_load = float(en["total"][k]) if k < t.size else float("nan")
+    d = steady_drift(t, en["balance"], t_load)
+    blown = en["t_blow_up"] is not None
+    return {"element": rec["element"], "n": rec["n"], "problem": rec["problem"], "integrator": rec["integrator"],
+            "h": rec["h"], "t_end": rec["t_end"], "t_reached": float(t[-1]) if t.size else 0.0,
+            "status": rec["status"], "failed": rec["status"] != "success" and not blown,
+            "t_fail": rec["t_fail"], "t_blow_up": en["t_blow_up"], "energy": e_load,
+            "drift": d["max"], "rate": d["rate"], "final": d["final"],
+            "relative": d["max"] / abs(e_load) if np.isfinite(e_load) and e_load else float("nan"),
+            "cpu": rec["cpu"], "steps": rec["stats"].get("steps", 0), "message": rec["message"]}
+
+
+def run(elements=None, integrators=tuple(INTEGRATORS), n: int | None = None, t_end_b2: float = 20.0,
+        t_end_b3: float = 10.0, h: float = 2e-3, dt_out: float = 0.02, quick: bool = False, out=None,
+        jobs: int | None = None, executor=None, plots: bool = True, progress: bool = True) -> dict:
+    """Run the study.
+
+    Parameters
+    ----------
+    elements : sequence of str, optional
+        Element types (default: all of BE2D, SQ2D, BE3D, SQ3D available);
+        planar ones fly as in B2, spatial ones as in B3.
+    integrators : sequence of str
+        Keys of :data:`INTEGRATORS`.
+    n : int, optional
+        Elements per beam (default 4).
+    t_end_b2, t_end_b3 : float
+        End times of the planar and the spatial runs.
+    h, dt_out : float
+        Step of the fixed-step methods and output interval.
+    quick : bool
+        Test-suite mode: BE2D, 2 elements, 4 s, h = 4e-3.
+    out, jobs, executor, plots, progress
+        As in :func:`studies.flying2d.run`.
+
+    Returns
+    -------
+    dict
+        ``rows`` (summary per run), ``records`` (histories), ``table``, ``path``.
+    """
+    names = available(elements if elements is not None else ELEMENTS)
+    if elements is not None and len(names) != len(list(elements)):
+        raise ValueError(f"`elements` must name types of {available(ELEMENTS)}, got {list(elements)}.")
+    unknown = [i for i in integrators if i not in INTEGRATORS]
+    if unknown:
+        raise ValueError(f"`integrators` must be keys of {list(INTEGRATORS)}, got {unknown}.")
+    if quick:
+        names = ["BE2D"] if elements is None else names
+        n, t_end_b2, t_end_b3, h = 2, 4.0, 4.0, 4e-3
+    cases = []
+    for name in names:
+        problem, n_default = ELEMENTS[name]
+        for integ in integrators:
+            c = {"element": name, "n": n or n_default, "problem": problem, "integrator": integ, "h": h,
+                 "t_end": t_end_b2 if problem == "B2" else t_end_b3, "dt_out": dt_out}
+            cost = c["t_end"] * c["n"] * (1 if name == "BE2D" else 3 if name in ("SQ2D", "BE3D") else 10)
+            cases.append(Case(c, label=f"{name} {c['n']} el ({problem}) {integ}", cost=cost))
+    cases.sort(key=lambda c: -c["cost"])
+    records = run_cases(run_case, cases, executor=executor, jobs=jobs,
+                        progress=Progress("energy", len(cases), progress))
+    key = {k: i for i, k in enumerate(INTEGRATORS)}
+    records.sort(key=lambda r: (list(ELEMENTS).index(r["element"]), key[r["integrator"]]))
+    path = output_dir("energy", out) if plots else None
+    if path is not None:   # keep the histories: post-processing can be redone without the runs
+        with open(path / "records.pkl", "wb") as f:
+            pickle.dump(records, f)
+    rows = [summarize(r) for r in records]
+    table = _table(rows, h)
+    if plots:
+        (path / "energy.md").write_text("# Energy drift in free flight\n\n" + table)
+        _plot(records, path)
+    return {"rows": rows, "records": records, "table": table, "path": path}
+
+
+def _f(x, spec):
+    return "-" if x is None or (isinstance(x, float) and not np.isfinite(x)) else format(x, spec)
+
+
+def _table(rows, h):
+    headers = ["element", "problem", "integrator", "run to (s)", "reached (s)", "fails at (s)", "blow-up at (s)",
+               "T+U at load end (J)", "max drift after load (J)", "relative", "rate (J/s)", "CPU (s)"]
+    body = [[r["element"] + f" {r['n']} el", r["problem"], r["integrator"], f"{r['t_end']:g}",
+             f"{r['t_reached']:.2f}", _f(r["t_fail"], ".2f") if r["failed"] else "-", _f(r["t_blow_up"], ".2f"),
+             _f(r["energy"], ".4g"), _f(r["drift"], ".2e"), _f(r["relative"], ".1e"), _f(r["rate"], ".1e"),
+             f"{r['cpu']:.1f}"] for r in rows]
+    text = (f"Fixed-step methods: h = {h:g} s, modified Newton tol 1e-8; IDA: rtol 1e-6, max order 2. "
+            "Planar elements: B2 (load ends at 2.5 s); spatial: B3 (load ends at 3 s).\n\n")
+    return text + markdown_table(headers, body)
+
+
+def _plot(records, path):
+    from ._flying_plots import figure, save
+    names = list(dict.fromkeys(r["element"] for r in records))
+    cols = min(2, len(names))
+    rows_ = (len(names) + cols - 1) // cols
+    fig, axes = figure(rows_, cols, figsize=(6.5 * cols, 3.8 * rows_), squeeze=False)
+    for ax, name in zip(axes.ravel(), names):
+        for k, r in enumerate(rec for rec in records if rec["element"] == name):
+            t_load = T_PULSE if r["problem"] == "B2" else T_HAT
+            m = r["t"] >= t_load - 1e-9
+            if m.sum() < 2:
+                continue
+            bal = r["energy"]["balance"][m]
+            ax.semilogy(r["t"][m], np.abs(bal - bal[0]) + 1e-14, color=f"C{k}", lw=1, label=r["integrator"])
+        ax.set(xlabel="t (s)", ylabel="|E(t) - E(t_load)| (J)", title=f"{name}: energy drift after the load")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7)
+    for ax in axes.ravel()[len(names):]:
+        ax.set_visible(False)
+    save(fig, path, "energy_drift.png")

@@ -1,0 +1,209 @@
+"""Integrators compared on B2: work-precision, Newton work per step, energy drift (design.md Sect. 1).
+
+The B2 beam (benchmarks.md; a small mesh of BE2D) and a stiffer variant
+(Young's modulus x 100: its axial and bending frequencies x 10) are integrated
+over [0, T] by Lobatto IIIA with 3 and 2 stages (modified and full Newton),
+Newmark (beta 1/4, gamma 1/2), HHT (alpha 0.05), generalized-alpha
+(rho_inf 0.8) over a range of step sizes, by Lobatto IIIA (3 stages) over a
+range of Newton tolerances, and by IDA (BDF, max order 2, undamped model)
+over a range of relative tolerances. The error of a run is the integrated tip
+error of chapter Eq. 115 against a fine reference (Lobatto IIIA, 3 stages,
+h = 1.25e-4 s, full Newton, tol 1e-10; T = 4 s, so the pulse -- 2.5 s -- and
+1.5 s of free flight), sampled every 0.01 s. Steps divide 2.5 s, so the
+load's kink in f'' at the end of the pulse falls on a step boundary.
+
+Reported per run: eps_T, CPU seconds, steps, Newton iterations and LU
+factorisations per step, the largest energy-balance error ``max |E - E(0)|``
+over the run (the work of the loads integrated along, see EnergyMonitor) and
+the drift after the pulse; per method the observed order (log-log fit of
+eps_T against h).
+
+IDA runs set ``OMP_NUM_THREADS=1`` (notes/ida.md); set it in the shell
+before the study starts to be sure it takes effect.
+
+Run: ``ancfdae study integrators [--quick] [--out DIR] [--jobs N]``.
+"""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from ._common import Progress, markdown_table, output_dir, run_cases
+from ._flying import T_PULSE, Case, b2_beam, eps_T, regress_order, simulate_case, steady_drift
+
+__all__ = ["run", "run_case", "METHODS"]
+
+#: label -> (simulate method, integrator options, Newton options)
+METHODS = {
+    "lobatto3": ("lobatto3", {}, {"jacobian": "modified"}),
+    "lobatto3-full": ("lobatto3", {}, {"jacobian": "full"}),
+    "lobatto2": ("lobatto2", {}, {"jacobian": "modified"}),
+    "lobatto2-full": ("lobatto2", {}, {"jacobian": "full"}),
+    "newmark": ("newmark", {}, {"jacobian": "modified"}),
+    "hht": ("hht", {"alpha": 0.05}, {"jacobian": "modified"}),
+    "generalized-alpha": ("generalized-alpha", {"rho_inf": 0.8}, {"jacobian": "modified"}),
+}
+MODELS = {"B2": 1.0, "B2-stiff": 100.0}
+STEPS = (1e-2, 5e-3, 2.5e-3, 1.25e-3, 6.25e-4)
+RTOLS = (1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
+NEWTON_TOLS = (1e-4, 1e-6, 1e-8, 1e-10)
+
+
+def run_case(case: dict) -> dict:
+    """One run: ``case = {model, n, method, h | rtol, newton_tol, t_end, dt_out, reference}``."""
+    os.environ.setdefault("OMP_NUM_THREADS", "1")
+    beam = b2_beam(case["element"], case["n"], E_scale=MODELS[case["model"]])
+    if case["method"] == "ida":
+        rec = simulate_case(beam, case["t_end"], method="ida", h=None, dt_out=case["dt_out"], rtol=case["rtol"])
+    else:
+        method, opts, newton = METHODS[case["method"]]
+        newton = dict(newton, tol=case.get("newton_tol", 1e-8))
+        rec = simulate_case(beam, case["t_end"], method=method, h=case["h"], dt_out=case["dt_out"], newton=newton,
+                            **opts)
+    rec.update({k: case.get(k) for k in ("model", "method", "h", "rtol", "newton_tol", "reference", "label")})
+    return rec
+
+
+def _cases(models, element, n, t_end, dt_out, steps, rtols, newton_tols, methods, h_ref):
+    cases = []
+    for model in models:
+        base = {"model": model, "element": element, "n": n, "t_end": t_end, "dt_out": dt_out}
+        cases.append(dict(base, method="lobatto3-full", h=h_ref, newton_tol=1e-10, reference=True))
+        for m in methods:
+            cases += [dict(base, method=m, h=h) for h in steps]
+        if newton_tols:
+            h_mid = steps[len(steps) // 2]
+            cases += [dict(base, method="lobatto3", h=h_mid, newton_tol=tol, tol_sweep=True)
+                      for tol in newton_tols if tol != 1e-8]
+        cases += [dict(base, method="ida", rtol=r) for r in rtols]
+    out = []
+    for c in cases:
+        what = f"rtol {c['rtol']:g}" if c["method"] == "ida" else f"h {c['h']:g}"
+        if c.get("tol_sweep"):
+            what += f", Newton tol {c['newton_tol']:g}"
+        cost = 1.0 / c["h"] if c["method"] != "ida" else 1.0 / c["rtol"] ** 0.3
+        out.append(Case(c, label=f"{c['model']} {c['method']} {what}" + (" (reference)" if c.get("reference") else ""),
+                        cost=cost))
+    out.sort(key=lambda c: -c["cost"])
+    return out
+
+
+def run(models=("B2", "B2-stiff"), element: str = "BE2D", n: int = 4, t_end: float = 4.0, dt_out: float = 0.01,
+        steps=STEPS, rtols=RTOLS, newton_tols=NEWTON_TOLS, methods=tuple(METHODS), h_ref: float = 1.25e-4,
+        quick: bool = False, out=None, jobs: int | None = None, executor=None, plots: bool = True,
+        progress: bool = True) -> dict:
+    """Run the study.
+
+    Parameters
+    ----------
+    models : sequence of {"B2", "B2-stiff"}
+        The B2 beam and its variant with E x 100.
+    element, n : str, int
+        Element type and mesh (default 4 BE2D elements).
+    t_end, dt_out : float
+        Time span and output interval of the tip and energy logs.
+    steps, rtols, newton_tols : sequences of float
+        Step sizes of the fixed-step methods, IDA relative tolerances and
+        Newton tolerances of the Lobatto-3 tolerance sweep (at the middle step).
+    methods : sequence of str
+        Keys of :data:`METHODS`.
+    h_ref : float
+        Step of the reference run.
+    quick : bool
+        Test-suite mode: B2 only, 2 elements, 1 s, three steps, two IDA
+        tolerances, no Newton-tolerance sweep.
+    out, jobs, executor, plots, progress
+        As in :func:`studies.flying2d.run`.
+
+    Returns
+    -------
+    dict
+        ``rows`` (one per run), ``orders`` (``{model: {method: order}}``),
+        ``table``, ``path``.
+    """
+    unknown = [m for m in methods if m not in METHODS]
+    if unknown:
+        raise ValueError(f"`methods` must be keys of {list(METHODS)}, got {unknown}.")
+    if quick:
+        models, n, t_end, h_ref = ("B2",), 2, 1.0, 6.25e-4
+        steps, rtols, newton_tols = (1e-2, 5e-3, 2.5e-3), (1e-5, 1e-7), ()
+    cases = _cases(models, element, n, t_end, dt_out, steps, rtols, newton_tols, methods, h_ref)
+    records = run_cases(run_case, cases, executor=executor, jobs=jobs,
+                        progress=Progress("integrators", len(cases), progress))
+    refs = {r["model"]: r for r in records if r["reference"]}
+    rows = []
+    for r in records:
+        if r["reference"]:
+            continue
+        ref = refs[r["model"]]
+        st = r["stats"]
+        steps_ = max(st.get("steps", 0), 1)
+        bal = r["energy"]["balance"]
+        row = {"model": r["model"], "method": r["method"], "h": r["h"], "rtol": r["rtol"],
+               "newton_tol": r["newton_tol"] or (1e-8 if r["method"] != "ida" else None), "status": r["status"],
+               "cpu": r["cpu"], "steps": st.get("steps", 0), "its_per_step": st.get("newton_iterations", 0) / steps_,
+               "lu_per_step": st.get("factorizations", 0) / steps_,
+               "eps_T": eps_T(r["t"], r["tip"], ref["t"], ref["tip"]) if r["status"] == "success" else float("nan"),
+               "energy_error": float(np.nanmax(np.abs(bal - bal[0]))) if bal.size else float("nan"),
+               "drift": steady_drift(r["t"], bal, T_PULSE)["max"] if t_end > T_PULSE else float("nan"),
+               "tol_sweep": r["newton_tol"] not in (None, 1e-8) and r["method"] == "lobatto3"}
+        rows.append(row)
+    rows.sort(key=lambda r: (r["model"], list(METHODS).index(r["method"]) if r["method"] in METHODS else 99,
+                             r["tol_sweep"], -(r["h"] or 0), -(r["rtol"] or 0), -(r["newton_tol"] or 0)))
+    orders = {}
+    for model in dict.fromkeys(r["model"] for r in rows):
+        orders[model] = {}
+        for m in methods:
+            rs = [r for r in rows if r["model"] == model and r["method"] == m and not r["tol_sweep"]
+                  and np.isfinite(r["eps_T"]) and r["eps_T"] > 0]
+            if len(rs) >= 2:
+                orders[model][m] = -regress_order([r["h"] for r in rs], [r["eps_T"] for r in rs])
+    table = _table(rows, orders, refs, t_end)
+    path = None
+    if plots:
+        path = output_dir("integrators", out)
+        (path / "integrators.md").write_text("# Integrators on B2: work-precision\n\n" + table)
+        _plot(rows, path)
+    return {"rows": rows, "orders": orders, "table": table, "path": path}
+
+
+def _table(rows, orders, refs, t_end):
+    headers = ["model", "method", "h (s) / rtol", "Newton tol", "eps_T", "CPU (s)", "steps", "its/step", "LU/step",
+               "max energy error (J)", "drift after pulse (J)", "status"]
+    body = []
+    for r in rows:
+        step = f"rtol {r['rtol']:g}" if r["method"] == "ida" else f"{r['h']:g}"
+        body.append([r["model"], r["method"], step, "-" if r["newton_tol"] is None else f"{r['newton_tol']:g}",
+                     f"{r['eps_T']:.3e}", r["cpu"], r["steps"], f"{r['its_per_step']:.2f}",
+                     f"{r['lu_per_step']:.3f}", f"{r['energy_error']:.2e}", f"{r['drift']:.2e}", r["status"]])
+    ref = next(iter(refs.values()))
+    text = (f"B2 with {ref['dof']} DOF, T = {t_end:g} s; reference: Lobatto IIIA 3 stages, h = "
+            f"{ref['h']:g} s, full Newton tol 1e-10. eps_T: chapter Eq. 115 against the reference.\n\n")
+    text += markdown_table(headers, body)
+    text += "\nObserved order in h (log-log fit of eps_T): " + "; ".join(
+        f"{model}: " + ", ".join(f"{m} {p:.2f}" for m, p in o.items()) for model, o in orders.items()) + "\n"
+    return text
+
+
+def _plot(rows, path):
+    from ._flying_plots import figure, save
+    models = list(dict.fromkeys(r["model"] for r in rows))
+    fig, axes = figure(1, len(models), figsize=(6 * len(models), 4.5), squeeze=False)
+    methods = list(METHODS) + ["ida"]
+    for ax, model in zip(axes[0], models):
+        for k, m in enumerate(methods):
+            rs = [r for r in rows if r["model"] == model and r["method"] == m and not r["tol_sweep"]
+                  and np.isfinite(r["eps_T"]) and r["eps_T"] > 0]
+            if rs:
+                style = "--" if m.endswith("-full") else "-"
+                ax.loglog([r["cpu"] for r in rs], [r["eps_T"] for r in rs], style, marker="os^v<>Dx"[k % 8],
+                          color=f"C{k}", label=m)
+        sweep = [r for r in rows if r["model"] == model and r["tol_sweep"] and np.isfinite(r["eps_T"])]
+        if sweep:
+            ax.loglog([r["cpu"] for r in sweep], [r["eps_T"] for r in sweep], "k*", ms=9,
+                      label="lobatto3, Newton tol 1e-4..1e-10")
+        ax.set(xlabel="CPU time (s)", ylabel="eps_T against the reference", title=f"{model}: work-precision")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    save(fig, path, "work_precision.png")
