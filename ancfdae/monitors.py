@@ -5,7 +5,7 @@ Every integrator drives a monitor through four calls:
 ``start(model, t0, q0, v0, a0)``
     once, before the first step;
 ``advance(t, q, v, a, nodes=None)``
-    after every accepted step (on IDA: after every output interval), with an
+    after every accepted step (on IDA: every internal step), with an
     optional quadrature of the step, ``nodes = (ts, Q, V, w)`` (times, stage
     coordinates and velocities as rows, weights that sum to the step size),
     for integrals over the step;
@@ -57,7 +57,7 @@ class EnergyMonitor(Monitor):
     supplies one (Lobatto IIIA: its Lobatto nodes and weights, exact for
     polynomials of degree 2s-3, error O(h^(2s-2)) on smooth power histories),
     otherwise with the trapezoidal rule over the step grid (error O(h^2); on
-    IDA the grid is the output grid). Output times that fall inside a step
+    IDA the grid of its internal steps). Output times that fall inside a step
     interpolate ``W_ext`` linearly. For the exact solution ``E`` is constant;
     ``drift = E(t) - E(t0)``.
 

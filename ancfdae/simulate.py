@@ -21,14 +21,14 @@ __all__ = ["simulate", "METHODS"]
 class Lobatto3(LobattoIIIA):
     """Lobatto IIIA with 3 stages (order 4; the chapter's integrator)."""
 
-    def __init__(self, model, h, *, newton=None, predictor="extrapolate"):
+    def __init__(self, model, h, *, newton=None, predictor="constant"):
         super().__init__(model, h, 3, newton=newton, predictor=predictor)
 
 
 class Lobatto2(LobattoIIIA):
     """Lobatto IIIA with 2 stages (trapezoidal rule, order 2)."""
 
-    def __init__(self, model, h, *, newton=None, predictor="extrapolate"):
+    def __init__(self, model, h, *, newton=None, predictor="constant"):
         super().__init__(model, h, 2, newton=newton, predictor=predictor)
 
 

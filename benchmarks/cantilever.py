@@ -66,8 +66,11 @@ def main(argv=None):
     p.add_argument("--max-elements", type=int, default=1024)
     p.add_argument("--element", default="BE2D")
     p.add_argument("--nodes", type=int, default=None, help="SQ elements: 3 (quadratic, default) or 2 (linear)")
+    p.add_argument("--kernel", default=None, choices=["auto", "numpy", "numba"], help="BE2D kernel option")
     args = p.parse_args(argv)
     options = {} if args.nodes is None else {"nodes": args.nodes}
+    if args.kernel is not None:
+        options["kernel"] = args.kernel
     rows = []
     meshes = [n for n in (1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1024) if n <= args.max_elements]
     print(f"B1 static solve, {args.element}, median of {args.repeats} (wall seconds)")

@@ -349,3 +349,19 @@ def test_residual_path_equals_the_jets():
     g, G = spin_gradient(a, d)
     assert rel_err(g, np.stack([x.v for x in gj], -1)) < 1e-14
     assert rel_err(G, np.stack([x.g for x in gj], -2)) < 1e-14
+
+
+def test_curved_reference_is_stress_free_and_rotation_invariant():
+    soft, sec = Material(1e5, 0.3, 2500.0), RectangularSection(0.05, 0.03)
+    s = np.linspace(0.0, 1.0, 9)
+    beam = Beam(BE3D(soft, sec), nodes=np.stack([np.cos(s), np.sin(s), 0.3 * s], axis=1))   # a helix
+    q = beam.initial_state()[0]
+    assert np.abs(beam.geom["k_ref"]).max() > 1.0          # curved and twisted reference
+    assert beam.energy(0.0, q, 0 * q).strain < 1e-25
+    R = rotation((1, 2, 3), 2.0)
+    Q = beam.nodal(q)
+    Q[:, :3], Q[:, 3:6] = Q[:, :3] @ R.T, Q[:, 3:6] @ R.T
+    beam.geom["directors"][:] = beam.geom["directors"] @ R.T
+    q = Q.reshape(-1)
+    assert beam.energy(0.0, q, 0 * q).strain < 1e-25
+    assert np.abs(beam.internal_forces(q, tangent=False)[0]).max() < 1e-10

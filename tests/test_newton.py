@@ -118,6 +118,7 @@ def test_unsolvable_fails_without_raising():
     assert s.stats.failed_solves == 1
 
 
+@pytest.mark.filterwarnings("ignore::scipy.linalg.LinAlgWarning")
 def test_singular_matrix_fails_cleanly():
     s = NewtonSolver()
     out = s.solve(lambda x: x - 1.0, lambda x: sp.csr_matrix((2, 2)), np.zeros(2))

@@ -203,6 +203,8 @@ class FixedStepIntegrator(ABC):
         self.newton = NewtonSolver(newton)
         self.status, self.message = "idle", ""
         self._h_matrix = None
+        #: build the step's quadrature nodes for the monitors (set by run() when there are monitors)
+        self.want_nodes = False
 
     # -- options record ----------------------------------------------------------------------
     def options(self) -> dict:
@@ -319,6 +321,7 @@ class FixedStepIntegrator(ABC):
             if not callable(k):
                 raise TypeError(f"`hooks` entries must be callables hook(t, q, v, a), got {k!r}.")
         rec = Recorder(self.model, monitors)
+        self.want_nodes = bool(rec.monitors)
         self.newton.stats = NewtonStats()
         wall = time.perf_counter()
         j = 0

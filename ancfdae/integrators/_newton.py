@@ -241,7 +241,9 @@ class NewtonSolver:
 
     def _eval(self, residual, x):
         self.stats.residual_evals += 1
-        r = np.asarray(residual(x), dtype=float)
+        r = residual(x)
+        if type(r) is not np.ndarray or r.dtype != np.float64:
+            r = np.asarray(r, dtype=float)
         if r.shape != x.shape:
             raise ValueError(f"`residual` must return shape {x.shape}, got {r.shape}.")
         return r
@@ -282,7 +284,7 @@ class NewtonSolver:
         x0 = np.array(x0, dtype=float, copy=True).ravel()
         self.stats.solves += 1
         r = self._eval(residual, x0)
-        if not np.isfinite(np.max(np.abs(r), initial=0.0)):
+        if r.size and not np.isfinite(np.abs(r).max()):
             self.stats.failed_solves += 1
             return NewtonOutcome(x0, False, 0, float("nan"), "residual at the initial guess is not finite")
         outcome = self._attempt(residual, jacobian, x0, r)
@@ -309,7 +311,7 @@ class NewtonSolver:
         full = opts.jacobian == "full"
         stale = self._lu is not None and not full
         x = x0.copy()
-        err0 = err = float(np.max(np.abs(r), initial=0.0))
+        err0 = err = float(np.abs(r).max()) if r.size else 0.0
         rel = max(opts.tol * err0, opts.atol)
         threshold = max(rel, self.residual_floor)
         if err <= threshold:
@@ -325,13 +327,13 @@ class NewtonSolver:
                 threshold = max(rel, self.residual_floor)  # the caller may update it with the Jacobian
             dx = self._lu.solve(-r)
             self.stats.iterations += 1
-            dx_max = float(np.max(np.abs(dx), initial=0.0))  # NaN/inf propagate into the max
+            dx_max = float(np.abs(dx).max()) if dx.size else 0.0  # NaN/inf propagate into the max
             if not np.isfinite(dx_max):
                 return NewtonOutcome(x, False, k, err, "Newton correction is not finite "
                                      "(singular iteration matrix?)"), stale
             x = x + dx
             r = self._eval(residual, x)
-            err_new = float(np.max(np.abs(r), initial=0.0))
+            err_new = float(np.abs(r).max()) if r.size else 0.0
             if not np.isfinite(err_new):
                 return NewtonOutcome(x, False, k, float("nan"),
                                      f"residual became non-finite at iteration {k}"), stale
@@ -340,7 +342,7 @@ class NewtonSolver:
             # Round-off stagnation: a fresh matrix, a correction at round-off
             # level and a residual that no longer falls -- the attainable accuracy.
             if (fresh and err_new > 0.5 * err
-                    and dx_max <= opts.xtol * max(1.0, float(np.max(np.abs(x))))):
+                    and dx_max <= opts.xtol * max(1.0, float(np.abs(x).max()))):
                 return NewtonOutcome(x, True, k, err_new, f"converged in {k} iterations "
                                      f"(correction at round-off level, max|r| = {err_new:.3e})"), stale
             rate = err_new / err if err > 0 else np.inf

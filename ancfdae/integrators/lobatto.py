@@ -21,7 +21,9 @@ the band structure of the model's matrices, has the blocks::
 
     dr_i / dA_k = delta_ik M_i + h a_ik D_i + h^2 (a^2)_ik K_i
 
-with ``K_i, D_i, M_i`` the exact Jacobian blocks at stage ``i``.
+with ``K_i, D_i, M_i`` the exact Jacobian blocks at stage ``i``. A model with the optional
+method ``residual_stages(ts, Q, V, A) -> R`` (columns = stages, e.g. :class:`~ancfdae.models.Beam`)
+has all implicit stages' residuals evaluated in one call; otherwise one ``residual`` call per stage.
 """
 from __future__ import annotations
 
@@ -120,12 +122,16 @@ class LobattoIIIA(FixedStepIntegrator):
         accurate.
     newton : NewtonOptions or dict, optional
         Default: modified Newton, relative tolerance 1e-8 (chapter Sect. 5.2).
-    predictor : {"extrapolate", "constant"}
-        Initial guess of the stage accelerations: the previous step's
-        collocation polynomial extrapolated, or ``a_n`` in every stage.
+    predictor : {"constant", "extrapolate"}
+        Initial guess of the stage accelerations: ``a_n`` in every stage
+        (default), or the previous step's collocation polynomial
+        extrapolated. With the relative residual test the iteration count
+        depends on the contraction rate, not on the initial residual: on
+        the 25-element BE2D pendulum (h = 1e-4) "extrapolate" took 5.0
+        instead of 4.7 iterations per step.
     """
 
-    def __init__(self, model, h, stages=3, *, newton=None, predictor="extrapolate"):
+    def __init__(self, model, h, stages=3, *, newton=None, predictor="constant"):
         super().__init__(model, h, newton=newton)
         if isinstance(stages, ButcherTableau):
             tab = stages
@@ -155,22 +161,18 @@ class LobattoIIIA(FixedStepIntegrator):
 
     def _init_impl(self):
         self._prev = None  # (h, stage accelerations (n, s)) of the last step
+        self._w_cache = None
 
-    # -- stage states ------------------------------------------------------------------------
-    def _stages(self, X, t, h):
-        """Stage coordinates and velocities (n, m) for stage accelerations ``X`` (n, m)."""
-        V_ = self.v[:, None] + h * (self.a[:, None] * self._a_first + X @ self._a_rest.T)
-        Q = self.q[:, None] + h * self._c * self.v[:, None] + h * h * (self.a[:, None] * self._a2_first
-                                                                        + X @ self._a2_rest.T)
-        return Q, V_
-
+    # -- predictor -------------------------------------------------------------------------
     def _guess(self, h):
         m = self._m
         if self.predictor == "constant" or self._prev is None:
             return np.repeat(self.a[:, None], m, axis=1)
         h_prev, A_prev = self._prev
-        W = _lagrange_weights(self.tableau.c, 1.0 + self._c * (h / h_prev))
-        return A_prev @ W.T
+        ratio = h / h_prev
+        if self._w_cache is None or self._w_cache[0] != ratio:
+            self._w_cache = (ratio, _lagrange_weights(self.tableau.c, 1.0 + self._c * ratio).T)
+        return A_prev @ self._w_cache[1]
 
     # -- iteration matrix --------------------------------------------------------------------
     def _pattern(self, K):
@@ -221,30 +223,52 @@ class LobattoIIIA(FixedStepIntegrator):
     def _step_impl(self, t, h):
         m, n = self._m, self.n_dof
         ts = t + self._c * h
+        # Stage states are affine in X: V = V0 + X @ CV, Q = Q0 + X @ CQ (constant parts once per step).
+        V0 = self.v[:, None] + (h * self._a_first) * self.a[:, None]
+        Q0 = self.q[:, None] + (h * self._c) * self.v[:, None] + (h * h * self._a2_first) * self.a[:, None]
+        CV, CQ = (h * self._a_rest).T, (h * h * self._a2_rest).T
+        if m == 1:
+            v0, q0, cv, cq, t1 = V0[:, 0], Q0[:, 0], CV[0, 0], CQ[0, 0], ts[0]
 
-        def residual(x):
-            X = x.reshape(n, m)
-            Q, V_ = self._stages(X, t, h)
-            R = np.empty((n, m))
-            for i in range(m):
-                R[:, i] = self._residual(ts[i], Q[:, i], V_[:, i], X[:, i])
-            return R.ravel()
+            def residual(x):
+                return self._residual(t1, q0 + cq * x, v0 + cv * x, x)
 
-        def jacobian(x):
-            X = x.reshape(n, m)
-            Q, V_ = self._stages(X, t, h)
-            blocks = [self._jacobian(ts[i], Q[:, i], V_[:, i], X[:, i]) for i in range(m)]
-            for i, blk in enumerate(blocks):
-                self._set_floor(blk, Q[:, i])
-            return self._matrix(blocks, h)
+            def jacobian(x):
+                qs = q0 + cq * x
+                blk = self._jacobian(t1, qs, v0 + cv * x, x)
+                self._set_floor(blk, qs)
+                return self._matrix([blk], h)
+        else:
+            stages = getattr(self.model, "residual_stages", None)
+
+            def residual(x):
+                X = x.reshape(n, m)
+                Q, V_ = Q0 + X @ CQ, V0 + X @ CV
+                if stages is not None:   # all stages in one model call (optional Model method)
+                    self._n_res += m
+                    return stages(ts, Q, V_, X).ravel()
+                R = np.empty((n, m))
+                for i in range(m):
+                    R[:, i] = self._residual(ts[i], Q[:, i], V_[:, i], X[:, i])
+                return R.ravel()
+
+            def jacobian(x):
+                X = x.reshape(n, m)
+                Q, V_ = Q0 + X @ CQ, V0 + X @ CV
+                blocks = [self._jacobian(ts[i], Q[:, i], V_[:, i], X[:, i]) for i in range(m)]
+                for i, blk in enumerate(blocks):
+                    self._set_floor(blk, Q[:, i])
+                return self._matrix(blocks, h)
 
         out = self.newton.solve(residual, jacobian, self._guess(h).ravel())
         if not out.converged:
             return False, f"Newton: {out.message}"
         X = out.x.reshape(n, m)
-        Q, V_ = self._stages(X, t, h)
-        A_all = np.column_stack([self.a, X])
-        self._prev = (h, A_all)
-        nodes = (np.r_[t, ts], np.column_stack([self.q, Q]).T, np.column_stack([self.v, V_]).T,
-                 h * self.tableau.b)
+        Q, V_ = Q0 + X @ CQ, V0 + X @ CV
+        if self.predictor == "extrapolate":
+            self._prev = (h, np.column_stack([self.a, X]))
+        nodes = None
+        if self.want_nodes:  # the step's Lobatto quadrature, for monitors that integrate over it
+            nodes = (np.r_[t, ts], np.column_stack([self.q, Q]).T, np.column_stack([self.v, V_]).T,
+                     h * self.tableau.b)
         return True, (Q[:, -1].copy(), V_[:, -1].copy(), X[:, -1].copy(), nodes)

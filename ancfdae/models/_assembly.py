@@ -73,16 +73,23 @@ class Assembler:
         r, c = np.divmod(uniq, n_free)
         self.indptr = np.concatenate([[0], np.cumsum(np.bincount(r, minlength=n_free))]).astype(np.int32)
         self.indices = c.astype(np.int32)
+        # Whole-array scatter indices: fixed entries go to one extra bin past the end, which is
+        # dropped; cheaper than boolean-mask indexing every call, and the same sums in the same
+        # order (bincount adds in input order), so bit-for-bit the masked result.
+        self._vec_all = np.where(fe.ravel() >= 0, fe.ravel(), n_free)
+        slot_all = np.full(keep.size, self.nnz, dtype=np.intp)
+        slot_all[keep] = self._slot
+        self._slot_all = slot_all
         # Diagonal slots, for adding a multiple of the identity with the pattern kept.
         self.diag_slot = np.searchsorted(uniq, np.arange(n_free, dtype=np.int64) * (n_free + 1))
 
     def vector(self, fe: np.ndarray) -> np.ndarray:
         """Sum element vectors (n_el, n_edof) into a free-coordinate vector."""
-        return np.bincount(self._vec_idx, weights=fe.ravel()[self._vec_mask], minlength=self.n_free)
+        return np.bincount(self._vec_all, weights=fe.ravel(), minlength=self.n_free + 1)[:self.n_free]
 
     def data(self, ke: np.ndarray) -> np.ndarray:
         """CSR data array of the sum of element matrices (n_el, n_edof, n_edof)."""
-        return np.bincount(self._slot, weights=ke.ravel()[self._mat_mask], minlength=self.nnz)
+        return np.bincount(self._slot_all, weights=ke.ravel(), minlength=self.nnz + 1)[:self.nnz]
 
     def csr(self, data: np.ndarray) -> sp.csr_matrix:
         """A CSR matrix with the fixed pattern and the given data.

@@ -41,12 +41,23 @@ angle ``theta`` and director ``d``:
 
 Either update leaves the nodal frame unchanged, and sets ``theta_dot`` to the
 node's physical spin ``omega1`` (with the new director ``d . e1 = 0``, hence
-``g = 0``), so nodal positions, slopes, frames and spins are unchanged.
-Inside an element the frame depends on the interpolated director, so an
-update changes the interior frames, energies and spins by a small amount that
-vanishes with the mesh size (measured in the tests; zero for motions in the
-plane perpendicular to the director). This, with the interpolated angle, is
-why BE3D does not conserve energy exactly across updates (chapter Sect. 5.3).
+``g = 0``), so nodal positions, slopes, frames and spins are unchanged, and a
+second update right after the first changes nothing. Inside an element the
+frame depends on the *interpolated* director, so an update changes the
+interior frames, the strain and the kinetic energy: by O(h^2) (h the element
+length) for a given deformed state, and not at all for motions in the plane
+normal to the director. This cannot be avoided with the chapter's linear
+interpolation of directors and angle.
+
+Consequence for dynamics (chapter Sect. 5.3): between updates the equations
+conserve ``T + U``; every update adds a jump. With an update after every
+time step the jumps accumulate at a rate independent of the step size, and
+they grow when neighbouring nodal directors drift apart (the projected
+directors by the holonomy of each node's tangent path, the post-rotated ones
+by the physical twist and bending between nodes), because their linear
+interpolation then shrinks towards zero and the interior frames turn fast.
+This is the energy blow-up of BE3D; without updates the energy stays
+conserved until the axis meets the fixed director (Eq. 99 singular).
 """
 from __future__ import annotations
 

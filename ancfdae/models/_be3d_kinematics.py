@@ -23,14 +23,14 @@ updates). With ``p = a.a``, ``m = d x a``, ``m2 = |m|^2``:
 
       omega1 = theta_dot + g(a) . a_dot,   g(a) = (a.d) m / (|a| m2).
 
-All quantities are returned as :class:`~ancfdae.models._jet_thin.Jet` objects with
+All quantities are returned as :class:`~ancfdae.models._scalar_jet.Jet` objects with
 exact derivatives with respect to the local variables.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from ._jet_thin import Jet
+from ._scalar_jet import Jet
 
 __all__ = ["curvatures", "curvature_energy", "spin_coefficients", "spin_gradient", "frames", "director_field",
            "cross", "EPS"]

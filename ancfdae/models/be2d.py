@@ -14,6 +14,8 @@ exact, for all elements and points in a few ``einsum`` calls.
 """
 from __future__ import annotations
 
+import importlib.util
+
 import numpy as np
 
 from .._validate import choice, positive_int
@@ -23,6 +25,23 @@ from ._quadrature import gauss
 from ._shapes import hermite
 
 __all__ = ["BE2D"]
+
+KERNELS = ("auto", "numpy", "numba")
+
+
+def _numba_available() -> bool:
+    return importlib.util.find_spec("numba") is not None
+
+
+def _resolve_kernel(kernel: str) -> str:
+    """The implementation behind a ``kernel`` option: "numpy" or "numba"."""
+    kernel = choice("kernel", kernel, KERNELS)
+    if kernel == "auto":
+        return "numba" if _numba_available() else "numpy"
+    if kernel == "numba" and not _numba_available():
+        raise ImportError("`kernel` 'numba' needs numba, which is not installed; install it with "
+                          "`pip install \"ancfdae[fast]\"` or use kernel='auto' or 'numpy'.")
+    return kernel
 
 # (r' x r'').e_z = r'^T P r''
 _P = np.array([[0.0, 1.0], [-1.0, 0.0]])
@@ -59,6 +78,14 @@ class BE2D(Element):
         Gauss points for the axial and the bending (curvature) terms. The
         defaults 5 and 3 (integration orders 9 and 5, as recommended at the
         end of Sect. 3.5) reproduce the chapter's Table 2.
+    kernel : {"auto", "numpy", "numba"}
+        Implementation of :meth:`internal_forces`. ``"numpy"``: vectorised
+        NumPy, the reference. ``"numba"``: one compiled loop over elements x
+        points (:mod:`ancfdae.models._be2d_numba`, same results to rounding;
+        needs the optional dependency numba, ``pip install "ancfdae[fast]"``;
+        the first call compiles, or loads the on-disk cache). ``"auto"``
+        (default): numba when importable, else NumPy. Settable later through
+        the ``kernel`` attribute.
     """
 
     name = "BE2D"
@@ -68,7 +95,7 @@ class BE2D(Element):
     formulations = ("structural", "continuum")
 
     def __init__(self, material: Material, section, formulation: str = "structural",
-                 axial_points: int = 5, bending_points: int = 3):
+                 axial_points: int = 5, bending_points: int = 3, kernel: str = "auto"):
         if not isinstance(material, Material):
             raise TypeError(f"`material` must be a Material, got {material!r}.")
         for attr in ("A", "I3", "I4"):
@@ -79,10 +106,27 @@ class BE2D(Element):
         self.formulation = choice("formulation", formulation, self.formulations)
         self.axial_points = positive_int("axial_points", axial_points)
         self.bending_points = positive_int("bending_points", bending_points)
+        self.kernel = kernel
+
+    @property
+    def kernel(self) -> str:
+        """The ``kernel`` option as given ("auto", "numpy" or "numba")."""
+        return self._kernel
+
+    @kernel.setter
+    def kernel(self, value):
+        self._impl = _resolve_kernel(value)
+        self._kernel = value
+        self._compiled = None
+
+    @property
+    def kernel_in_use(self) -> str:
+        """The implementation that runs: "numpy" or "numba"."""
+        return self._impl
 
     def __repr__(self):
         return (f"BE2D(formulation={self.formulation!r}, axial_points={self.axial_points}, "
-                f"bending_points={self.bending_points})")
+                f"bending_points={self.bending_points}, kernel={self._kernel!r})")
 
     # -- mesh -----------------------------------------------------------
     def reference_coordinates(self, points, frames):
@@ -222,6 +266,8 @@ class BE2D(Element):
         return np.sum(geom["w"] * self._densities(g, c, geom, hessian=False)[0], axis=1)
 
     def internal_forces(self, geom, q, tangent=True):
+        if self._impl == "numba":
+            return self._internal_forces_numba(geom, q, tangent)
         w = geom["w"]
         g, c, dg, dc = self._invariants(geom, q)
         D = self._densities(g, c, geom, hessian=tangent)
@@ -239,6 +285,21 @@ class BE2D(Element):
         first = np.stack([wg, wc], axis=1).reshape(n_el, 1, 2 * n_pts)
         K = A @ B + (first @ geom["d2"]).reshape(n_el, 8, 8)
         return f, K
+
+    def _internal_forces_numba(self, geom, q, tangent):
+        """The compiled kernel; imported (and numba with it) on first use."""
+        if self._compiled is None:
+            from . import _be2d_numba as nb
+            form = nb.STRUCTURAL if self.formulation == "structural" else nb.CONTINUUM
+            E, sec = self.material.E, self.section
+            self._compiled = (nb.be2d_forces, form, E * sec.A, E, sec.I3, sec.I4)
+        fn, form, EA, E, I, I4 = self._compiled
+        nbg = geom.get("_numba")
+        if nbg is None:   # C-contiguous float copies for the compiled loop, once per geometry
+            nbg = geom["_numba"] = tuple(np.ascontiguousarray(geom[k], dtype=float)
+                                         for k in ("dN_e", "ddN_e", "w", "eps_ref", "K_ref"))
+        f, K = fn(np.ascontiguousarray(q, dtype=float), *nbg, geom["n_a"], form, EA, E, I, I4, bool(tangent))
+        return f, (K if tangent else None)
 
     def shape_matrix(self, s, lengths):
         N, _, _ = hermite(np.asarray(s, dtype=float), lengths)

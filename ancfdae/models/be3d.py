@@ -14,7 +14,7 @@ from .._validate import choice, finite_vector, positive_int
 from ._be3d_dynamics import UPDATES, rotary_inertia, rotary_kinetic_energy, update_directors
 from ._be3d_kinematics import curvature_energy, curvatures, director_field, frames, spin_gradient
 from ._element import Element
-from ._jet_thin import Jet
+from ._scalar_jet import Jet
 from ._shapes import hermite, linear
 from ._thin import (PointRule, assemble, axial_energy, check_material_section, clamp_coordinates,
                     hermite_operator, translational_mass)
@@ -281,7 +281,16 @@ class BE3D(Element):
         return f, Sx.T @ dfa @ Sx + np.outer(Nt, Me1.g @ Sx)
 
     def inertia(self, geom, q, v, a, jacobian=True):
-        """Rotary inertia about the axis: ``f``, and ``df/dq, df/dv, df/da`` (see :mod:`._be3d_dynamics`)."""
+        """Rotary inertia about the axis: ``f``, and ``df/dq, df/dv, df/da`` (exact).
+
+        From ``T_rot = 1/2 int rho J omega1^2 dxi`` with the spin
+        ``omega1 = w(q) . v`` (``w = N_theta + Sx^T g(r')``), Lagrange's
+        equations give ``f = int rho J [w Omega + omega1 Sx^T (G - G^T) r'_dot]``,
+        ``Omega = w . a + r'_dot^T G r'_dot``, ``G = dg/dr'``: the mass term
+        ``M_rot(q) a`` plus gyroscopic terms (derivation in
+        :mod:`._be3d_dynamics`). Returns ``(f, None, None, None)`` when
+        ``jacobian`` is False.
+        """
         return rotary_inertia(geom["inertia"], geom, q, v, a, self.rhoJ, jacobian)
 
     def kinetic_energy_extra(self, geom, q, v):

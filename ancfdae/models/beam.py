@@ -130,9 +130,15 @@ class Beam:
         self._asm = Assembler(self.edofs, free_of_full, self.n_dof)
         self.mass_is_constant = bool(element.mass_is_constant)
         self._M_data = self._asm.data(element.mass_matrix(self.geom))
+        self._M_csr = self._asm.csr(self._M_data)   # constant-mass product M a, built once
         self._zero_data = np.zeros(self._asm.nnz)
         self.load_factor = 1.0
         self._setup_loads(loads)
+        # Gather of the element coordinates from (free q, fixed reference values) in one take.
+        ext_of_full = free_of_full.copy()
+        ext_of_full[fixed] = self.n_dof + np.arange(int(fixed.sum()))
+        self._q_fixed = self.q_ref[fixed].copy()
+        self._gather = ext_of_full[self.edofs]
         self._v0 = self._initial_velocity(initial_velocity)
 
     # -- geometry helpers -------------------------------------------------
@@ -277,9 +283,11 @@ class Beam:
         return V.reshape(-1)[self.free]
 
     def mass(self, q=None) -> sp.csr_matrix:
-        """Mass matrix M(q) (constant unless the element says otherwise)."""
-        if self.mass_is_constant or q is None:
+        """Mass matrix M(q) (constant unless the element says otherwise; ``q=None``: the reference state)."""
+        if self.mass_is_constant:
             return self._asm.csr(self._M_data.copy())
+        if q is None:
+            q = self.q_ref[self.free]
         _, blocks = self._inertia(q, np.zeros(self.n_dof), np.zeros(self.n_dof), True)
         return self._asm.csr(self._M_data + blocks[2])
 
@@ -291,27 +299,74 @@ class Beam:
         blocks = tuple(self._asm.data(b) for b in out[1:]) if jac else None
         return f, blocks
 
+    def _element_q(self, q):
+        """Element coordinates (n_el, n_edof) of free coordinates ``q`` (= ``expand(q)[edofs]``)."""
+        return np.concatenate((q, self._q_fixed))[self._gather]
+
+    def _f_external(self, t, q, tangent):
+        """``fnc + f_gravity`` (free vector) and the load tangent data (or None); skips the
+        non-conservative pass when the beam has no such loads (bit-for-bit: 0 + f_g = f_g)."""
+        if not self._dead and not self._moments:
+            return self._f_gravity, None
+        fnc, kload = self._f_nonconservative(t, self.expand(q), tangent)
+        return fnc + self._f_gravity, kload
+
     def internal_forces(self, q, tangent=True):
         """Assembled ``dU/dq`` (free vector) and tangent CSR data (or None)."""
-        fe, ke = self.element.internal_forces(self.geom, self.expand(q)[self.edofs], tangent)
+        fe, ke = self.element.internal_forces(self.geom, self._element_q(q), tangent)
         return self._asm.vector(fe), (self._asm.data(ke) if tangent else None)
 
     def residual(self, t, q, v, a):
         """``r = M(q) a + f_int(q) [+ inertia(q, v, a)] - lambda f_ext(t, q)``."""
-        qf = self.expand(q)
-        fe, _ = self.element.internal_forces(self.geom, qf[self.edofs], False)
-        r = self._asm.vector(fe) + self._asm.csr(self._M_data) @ a
+        fe, _ = self.element.internal_forces(self.geom, self._element_q(q), False)
+        r = self._asm.vector(fe) + self._M_csr @ a
         if not self.mass_is_constant:
             r += self._inertia(q, v, a, False)[0]
-        fnc, _ = self._f_nonconservative(t, qf, False)
-        return r - self.load_factor * (fnc + self._f_gravity)
+        return r - self.load_factor * self._f_external(t, q, False)[0]
+
+    def residual_stages(self, ts, Q, V, A):
+        """Residuals of several stages in one element pass: column ``i`` of the (n_dof, m) result is
+        ``residual(ts[i], Q[:, i], V[:, i], A[:, i])`` (optional Model method; Lobatto IIIA uses it).
+
+        The element kernel runs once on the stages' elements stacked (a geometry for ``m`` copies of
+        the mesh, prepared on first use), which halves the per-call overhead of small meshes.
+        """
+        ts = np.asarray(ts, dtype=float)
+        m = ts.size
+        if not self.mass_is_constant:
+            return np.column_stack([self.residual(ts[i], Q[:, i], V[:, i], A[:, i]) for i in range(m)])
+        geom, gather, idx = self._stage_geometry(m)
+        n = self.n_dof
+        ext = np.empty((n + self._q_fixed.size, m))   # (free q; fixed values) per stage, stage fastest
+        ext[:n] = Q
+        ext[n:] = self._q_fixed[:, None]
+        fe, _ = self.element.internal_forces(geom, ext.ravel().take(gather), False)
+        F = np.bincount(idx, weights=fe.ravel(), minlength=m * (n + 1)).reshape(m, n + 1)[:, :n].T
+        R = F + self._M_csr @ A
+        if not self._dead and not self._moments:
+            R -= self.load_factor * self._f_gravity[:, None]
+        else:
+            for i in range(m):
+                R[:, i] -= self.load_factor * self._f_external(ts[i], Q[:, i], False)[0]
+        return R
+
+    def _stage_geometry(self, m):
+        """Element geometry of ``m`` stacked copies of the mesh and the matching scatter index."""
+        cache = self.__dict__.setdefault("_stage_cache", {})
+        if m not in cache:
+            q_ref_e = self.q_ref[self.edofs]
+            geom = self.element.prepare(np.tile(q_ref_e, (m, 1)), np.tile(self.lengths, m))
+            vec_all = self._asm._vec_all
+            idx = (np.arange(m)[:, None] * (self.n_dof + 1) + vec_all[None, :]).ravel()
+            gather = (self._gather[None] * m + np.arange(m)[:, None, None]).reshape(-1, self._gather.shape[1])
+            cache[m] = (geom, gather, idx)
+        return cache[m]
 
     def residual_jacobian(self, t, q, v, a):
         """``(residual, jacobian)`` from one kernel pass (the fused path of full Newton)."""
-        qf = self.expand(q)
-        fe, ke = self.element.internal_forces(self.geom, qf[self.edofs], True)
-        fnc, kload = self._f_nonconservative(t, qf, True)
-        r = self._asm.vector(fe) + self._asm.csr(self._M_data) @ a - self.load_factor * (fnc + self._f_gravity)
+        fe, ke = self.element.internal_forces(self.geom, self._element_q(q), True)
+        fext, kload = self._f_external(t, q, True)
+        r = self._asm.vector(fe) + self._M_csr @ a - self.load_factor * fext
         K = self._asm.data(ke)
         if kload is not None:
             K -= self.load_factor * kload
@@ -325,10 +380,9 @@ class Beam:
 
     def jacobian(self, t, q, v, a) -> JacobianBlocks:
         """Exact ``dr/dq``, ``dr/dv``, ``dr/da`` with one shared CSR pattern."""
-        qf = self.expand(q)
-        _, ke = self.element.internal_forces(self.geom, qf[self.edofs], True)
+        _, ke = self.element.internal_forces(self.geom, self._element_q(q), True)
         K = self._asm.data(ke)
-        _, kload = self._f_nonconservative(t, qf, True)
+        kload = self._f_external(t, q, True)[1] if self._moments else None
         if kload is not None:
             K -= self.load_factor * kload
         D = self._zero_data
@@ -340,7 +394,7 @@ class Beam:
 
     def energy(self, t, q, v) -> Energy:
         """Kinetic ``1/2 v^T M v`` (+ element extra), strain, gravity potential."""
-        T = 0.5 * v @ (self._asm.csr(self._M_data) @ v)
+        T = 0.5 * v @ (self._M_csr @ v)
         if not self.mass_is_constant:
             qf, vf = self.expand(q), self._expand_v(v)
             T += float(np.sum(self.element.kinetic_energy_extra(self.geom, qf[self.edofs], vf[self.edofs])))

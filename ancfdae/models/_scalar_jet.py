@@ -1,4 +1,4 @@
-"""Second-order forward-mode automatic differentiation on NumPy arrays ("jets").
+"""Second-order forward-mode automatic differentiation of scalar expressions ("jets"), with operators.
 
 A :class:`Jet` carries a value and its exact gradient and Hessian with respect
 to ``n`` local variables, for a whole batch of points at once: ``v`` has the
@@ -11,12 +11,15 @@ velocity as short expressions in a few polynomial invariants of the slope
 ``r'`` and its derivative ``r''``; propagating jets through those expressions
 gives the exact first and second derivatives without hand-expanded formulae
 (design.md Sect. 3: exact Jacobians, analytic or automatic differentiation).
+:mod:`._jet` holds the vector-valued, function-style jets of the SQ elements;
+this module overloads the arithmetic operators of scalar jets instead, which
+keeps the BE3D expressions readable as written in the chapter.
 """
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["Jet", "const", "dot"]
+__all__ = ["Jet"]
 
 
 def _outer(a, b):
@@ -106,13 +109,3 @@ class Jet:
         c, s = np.cos(self.v), np.sin(self.v)
         return self._chain(s, c, -s)
 
-
-def const(v, n: int, second: bool) -> Jet:
-    """A jet of a quantity that does not depend on the variables."""
-    v = np.asarray(v, dtype=float)
-    return Jet(v, np.zeros(v.shape + (n,)), np.zeros(v.shape + (n, n)) if second else None)
-
-
-def dot(u, w) -> Jet:
-    """Dot product of two 3-vectors given as sequences of jets (or arrays)."""
-    return u[0] * w[0] + u[1] * w[1] + u[2] * w[2]

@@ -1,0 +1,69 @@
+"""BE2D kernel option: the compiled (numba) kernel equals the NumPy reference; option validation."""
+import numpy as np
+import pytest
+
+from ancfdae import Material, RectangularSection
+from ancfdae.models import BE2D, Beam
+from ancfdae.models import be2d as be2d_module
+
+
+def _states(formulation, kernel, n_el=5, seed=0):
+    el = BE2D(Material(2.1e11, 0.3, 7800.0), RectangularSection(0.1), formulation=formulation, kernel=kernel)
+    beam = Beam(el, n_el, 2.0, supports={0: "clamp"})
+    rng = np.random.default_rng(seed)
+    q0 = beam.initial_state()[0]
+    return el, beam, [beam.expand(q0 + s * rng.standard_normal(beam.n_dof))[beam.edofs] for s in (0.0, 0.01, 0.1)]
+
+
+@pytest.mark.parametrize("formulation", ["structural", "continuum"])
+def test_numba_kernel_equals_numpy_kernel(formulation):
+    pytest.importorskip("numba")
+    el, beam, states = _states(formulation, "numba")
+    assert el.kernel_in_use == "numba"
+    scale_f = scale_K = 0.0
+    for qe in states:
+        f1, K1 = el.internal_forces(beam.geom, qe, True)
+        f1n, none = el.internal_forces(beam.geom, qe, False)
+        el.kernel = "numpy"
+        f0, K0 = el.internal_forces(beam.geom, qe, True)
+        el.kernel = "numba"
+        assert none is None and np.array_equal(f1, f1n)
+        # relative to the largest entry over the states (the reference state has f = 0)
+        scale_f, scale_K = max(scale_f, np.abs(f0).max()), max(scale_K, np.abs(K0).max())
+        assert np.abs(f1 - f0).max() <= 1e-12 * scale_f
+        assert np.abs(K1 - K0).max() <= 1e-12 * scale_K
+    assert scale_f > 0
+
+
+def test_auto_kernel_follows_numba_availability(monkeypatch):
+    monkeypatch.setattr(be2d_module, "_numba_available", lambda: False)
+    el = BE2D(Material(2.1e11, 0.3, 7800.0), RectangularSection(0.1))
+    assert el.kernel == "auto" and el.kernel_in_use == "numpy"
+    with pytest.raises(ImportError, match="kernel.*numba"):
+        BE2D(Material(2.1e11, 0.3, 7800.0), RectangularSection(0.1), kernel="numba")
+    monkeypatch.setattr(be2d_module, "_numba_available", lambda: True)
+    assert BE2D(Material(2.1e11, 0.3, 7800.0), RectangularSection(0.1)).kernel_in_use == "numba"
+
+
+def test_unknown_kernel_is_rejected():
+    with pytest.raises(ValueError, match="kernel"):
+        BE2D(Material(2.1e11, 0.3, 7800.0), RectangularSection(0.1), kernel="fortran")
+
+
+@pytest.mark.parametrize("kernel", ["numpy", "numba"])
+def test_residual_stages_equal_per_stage_residuals(kernel):
+    if kernel == "numba":
+        pytest.importorskip("numba")
+    from ancfdae import Gravity, PointForce, PointMoment
+    beam = Beam(BE2D(Material(2.1e11, 0.3, 7800.0), RectangularSection(0.1), kernel=kernel), 5, 2.0,
+                supports={0: "clamp"}, loads=[PointForce((1e5, 2e5), s=1.3, time=lambda t: 1.0 + t),
+                                              PointMoment(3e5, node=-1), Gravity((0.0, -9.81))])
+    rng = np.random.default_rng(4)
+    n = beam.n_dof
+    ts = np.array([0.1, 0.7, 0.9])
+    Q = beam.initial_state()[0][:, None] + 0.01 * rng.standard_normal((n, 3))
+    V, A = rng.standard_normal((n, 3)), rng.standard_normal((n, 3))
+    R = beam.residual_stages(ts, Q, V, A)
+    R0 = np.column_stack([beam.residual(ts[i], Q[:, i], V[:, i], A[:, i]) for i in range(3)])
+    assert R.shape == (n, 3)
+    assert np.abs(R - R0).max() <= 1e-14 * np.abs(R0).max()

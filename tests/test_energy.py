@@ -1,0 +1,120 @@
+"""Energy balance E = T + U + V - W_ext (design.md Sect. 6) under every integrator.
+
+Toy: the spring chain of toy_models with a pulse force (W_ext != 0 while it acts).
+B2 (benchmarks.md): free BE2D beam in the plane, 4 elements, force and moment pulse for 2.5 s,
+then free motion; E must stay constant after 2.5 s up to the integrator's accuracy.
+"""
+import functools
+
+import numpy as np
+import pytest
+
+from ancfdae import EnergyMonitor, Material, PointForce, PointMoment, PointSensor, RectangularSection, simulate
+from ancfdae.loads import pulse
+from ancfdae.models import BE2D, Beam
+from toy_models import SpringChain
+
+T_LOAD, T_END = 2.5, 3.5
+T_EVAL = np.linspace(0.0, T_END, 71)
+
+
+def b2_beam(n_elements=4):
+    """benchmarks.md B2: L = 1, a = 0.05, E = 1e5, nu = 0.3, rho = 2500, r(s) = s (0.6, 0.8)."""
+    el = BE2D(Material(E=1e5, nu=0.3, rho=2500.0), RectangularSection(0.05))
+    return Beam(el, n_elements=n_elements, length=1.0, direction=(0.6, 0.8),
+                loads=[PointForce((0.8, 0.0), node=0, time=pulse(T_LOAD)),
+                       PointMoment(0.8, node=0, time=pulse(T_LOAD))])
+
+
+@functools.lru_cache(maxsize=None)
+def b2_run(method, key, **kw):
+    kw = {k: (dict(v) if isinstance(v, tuple) else v) for k, v in kw.items()}
+    opts = {"rtol": key} if method == "ida" else {"h": key}
+    return simulate(b2_beam(), (0.0, T_END), method, t_eval=T_EVAL, monitors=[EnergyMonitor(), PointSensor(s=0.0)],
+                    **opts, **kw)
+
+
+def free_drift(res):
+    """max |E(t) - E(2.5)| for t >= 2.5 (no load: E must be constant)."""
+    E, t = res.monitors["energy"]["balance"], res.t
+    after = E[t >= T_LOAD - 1e-12]
+    return float(np.max(np.abs(after - after[0])))
+
+
+def _order(d_coarse, d_fine):
+    return np.log2(d_coarse / d_fine)
+
+
+@pytest.mark.parametrize("method, declared", [("lobatto3", 4), ("lobatto2", 2), ("newmark", 2)])
+def test_b2_balance_kept_to_the_order(method, declared):
+    coarse, fine = b2_run(method, 0.01), b2_run(method, 0.005)
+    assert coarse.success and fine.success
+    p = _order(free_drift(coarse), free_drift(fine))
+    assert p > declared - 0.5, (method, free_drift(coarse), free_drift(fine), p)
+    assert free_drift(fine) < 0.02 * fine.monitors["energy"]["scale"]
+    assert not fine.monitors["energy"]["blow_up"]
+
+
+def test_b2_generalized_alpha_dissipates():
+    ga, nm = b2_run("generalized-alpha", 0.005, rho_inf=0.5), b2_run("newmark", 0.005)
+    E = ga.monitors["energy"]["balance"][ga.t >= T_LOAD - 1e-12]
+    assert E[-1] < E[0] - 5 * free_drift(nm)  # energy lost, far beyond the trapezoidal rule's error
+    # the loss grows over the free motion (a trend, not noise)
+    assert np.polyfit(np.arange(E.size), E, 1)[0] < 0
+
+
+def test_b2_ida_drift_shrinks_with_rtol():
+    d = [free_drift(b2_run("ida", r)) for r in (1e-4, 1e-5)]
+    assert d[1] < 0.5 * d[0], d
+
+
+def test_b2_integrators_agree_on_tip_trajectory():
+    """Point B's trajectory: Lobatto IIIA-3, Newmark, generalized-alpha, IDA agree to their accuracy."""
+    ref = b2_run("lobatto3", 0.005).monitors["point@0"]["position"]
+    scale = np.max(np.abs(ref - ref[0]))
+    # measured: lobatto3 (h 0.01) 2.5e-3, IDA (rtol 1e-5) 4e-4, newmark 2.8e-2, gen.-alpha 2.7e-2 of the motion
+    for method, key, tol in [("lobatto3", 0.01, 5e-3), ("ida", 1e-5, 5e-3), ("newmark", 0.005, 5e-2),
+                             ("generalized-alpha", 0.005, 5e-2)]:
+        kw = {"rho_inf": 0.5} if method == "generalized-alpha" else {}
+        pos = b2_run(method, key, **kw).monitors["point@0"]["position"]
+        assert np.max(np.abs(pos - ref)) < tol * scale, (method, np.max(np.abs(pos - ref)) / scale)
+
+
+def test_modified_newton_matches_full_newton_with_far_fewer_factorizations():
+    mod, full = b2_run("lobatto3", 0.005), b2_run("lobatto3", 0.005, newton=(("jacobian", "full"),))
+    assert mod.success and full.success
+    np.testing.assert_allclose(mod.q, full.q, rtol=0, atol=1e-6 * np.max(np.abs(full.q)))
+    assert mod.stats["factorizations"] * 10 < full.stats["factorizations"]
+    assert full.stats["factorizations"] == full.stats["newton_iterations"]
+
+
+def _chain_drift(method, h):
+    res = simulate(SpringChain(3, force=(4.0, 2.0), T=0.5), (0, 1.5), method, h=h, monitors=[EnergyMonitor()])
+    return res.monitors["energy"]["max_abs_drift"]
+
+
+@pytest.mark.parametrize("method, declared", [("lobatto3", 4), ("newmark", 2)])
+def test_balance_includes_work_of_loads(method, declared):
+    """With the work W_ext of the pulse force, E is conserved to the order also while it acts."""
+    d1, d2 = _chain_drift(method, 0.02), _chain_drift(method, 0.01)
+    assert _order(d1, d2) > declared - 0.5, (d1, d2)
+    res = simulate(SpringChain(3, force=(4.0, 2.0), T=0.5), (0, 1.5), method, h=0.01, monitors=[EnergyMonitor()])
+    log = res.monitors["energy"]
+    assert np.max(np.abs(log["work"])) > 20 * log["max_abs_drift"]  # the loads did real work
+
+
+def test_energy_monitor_log_and_checks():
+    res = simulate(SpringChain(2), (0, 0.1), "newmark", h=0.01, t_eval=[0.0, 0.05, 0.1],
+                   monitors=[EnergyMonitor(name="E")])
+    log = res.monitors["E"]
+    for key in ("kinetic", "strain", "potential", "work", "total", "balance", "drift"):
+        assert log[key].shape == (3,)
+    np.testing.assert_allclose(log["total"], log["kinetic"] + log["strain"] + log["potential"])
+    np.testing.assert_allclose(log["balance"], log["total"] - log["work"])
+    assert log["drift"][0] == 0.0 and not log["blow_up"] and log["t_blow_up"] is None
+    with pytest.raises(ValueError, match="blowup"):
+        EnergyMonitor(blowup=0.0)
+    with pytest.raises(ValueError, match="stop_on_blowup"):
+        EnergyMonitor(stop_on_blowup="yes")
+    with pytest.raises(ValueError, match="exactly one"):
+        PointSensor()
