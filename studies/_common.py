@@ -1,6 +1,7 @@
 """Shared plumbing of the studies: output folder, progress, markdown tables, parallel sweeps."""
 from __future__ import annotations
 
+import multiprocessing
 import os
 import sys
 import time
@@ -74,7 +75,10 @@ def run_cases(fn, cases, executor: Executor | None = None, jobs: int | None = No
         return out
     own = executor is None
     if own:
-        executor = ProcessPoolExecutor(max_workers=jobs or os.cpu_count())
+        # "spawn": forking a process that already runs threads (OpenMP, numba, SUNDIALS -- e.g. inside a
+        # test session) can deadlock the children; fresh interpreters cost ~1 s each.
+        executor = ProcessPoolExecutor(max_workers=jobs or os.cpu_count(),
+                                       mp_context=multiprocessing.get_context("spawn"))
     try:
         futures = [executor.submit(fn, case) for case in cases]
         results = []
