@@ -127,7 +127,7 @@ def run(models=("B2", "B2-stiff"), element: str = "BE2D", n: int = 4, t_end: flo
         raise ValueError(f"`methods` must be keys of {list(METHODS)}, got {unknown}.")
     if quick:
         models, n, t_end, h_ref = ("B2",), 2, 1.0, 6.25e-4
-        steps, rtols, newton_tols = (1e-2, 5e-3, 2.5e-3), (1e-5, 1e-7), ()
+        steps, rtols, newton_tols = (1e-2, 5e-3, 2.5e-3), ((1e-5, 1e-7) if rtols else ()), ()
     cases = _cases(models, element, n, t_end, dt_out, steps, rtols, newton_tols, methods, h_ref)
     records = run_cases(run_case, cases, executor=executor, jobs=jobs,
                         progress=Progress("integrators", len(cases), progress))
