@@ -97,7 +97,11 @@ class Model(Protocol):
     never finite differences at run time. Models may also provide
     ``accept_step(t, q, v) -> (q, v)``, a hook that integrators and the
     static solver call after every accepted step (BE3D's director update
-    uses it); it must leave the physical configuration unchanged.
+    uses it); it must leave the physical configuration unchanged at the
+    nodes. Optional fast paths that solvers use when present:
+    ``residual_jacobian(t, q, v, a) -> (r, JacobianBlocks)`` (one kernel
+    pass; full Newton) and ``residual_stages(ts, Q, V, A) -> (n_dof, m)``
+    (all implicit stages of a Runge-Kutta step in one pass; Lobatto IIIA).
     """
 
     n_dof: int

@@ -8,7 +8,7 @@ import time
 from concurrent.futures import Executor, ProcessPoolExecutor
 from pathlib import Path
 
-__all__ = ["output_dir", "Progress", "markdown_table", "run_cases"]
+__all__ = ["output_dir", "Progress", "markdown_table", "run_cases", "command_line"]
 
 
 def output_dir(name: str, out=None) -> Path:
@@ -90,3 +90,16 @@ def run_cases(fn, cases, executor: Executor | None = None, jobs: int | None = No
     finally:
         if own:
             executor.shutdown()
+
+
+def command_line(run, doc: str, argv=None) -> None:
+    """``python -m ancfdae.studies.NAME [--quick] [--out DIR] [--jobs N]``: run a study and print its table."""
+    import argparse
+    p = argparse.ArgumentParser(description=doc.strip().splitlines()[0])
+    p.add_argument("--quick", action="store_true", help="small, fast version (what the tests run)")
+    p.add_argument("--out", default=None, help="output folder (default out/NAME)")
+    p.add_argument("--jobs", type=int, default=None, help="worker processes for the sweep")
+    args = p.parse_args(argv)
+    res = run(quick=args.quick, out=args.out, jobs=args.jobs)
+    print(res["table"])
+    print(f"written to {res['path']}")

@@ -23,7 +23,7 @@ import pickle
 
 import numpy as np
 
-from ._common import Progress, markdown_table, output_dir, run_cases
+from ._common import command_line, Progress, markdown_table, output_dir, run_cases
 from ._flying import FAMILY, Case, T_PULSE, available, b2_beam, eps_T, regress_order, simulate_case, steady_drift
 
 __all__ = ["run", "run_case", "ELEMENTS"]
@@ -194,16 +194,8 @@ def _table(rows, references, orders, orders_window, n_ref, t_end, h, t_window):
 
 
 def main(argv=None):
-    """Command-line entry: ``python -m ancfdae.studies.flying2d [--quick] [--jobs N]``."""
-    import argparse
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--quick", action="store_true")
-    p.add_argument("--out", default=None)
-    p.add_argument("--jobs", type=int, default=None)
-    args = p.parse_args(argv)
-    res = run(quick=args.quick, out=args.out, jobs=args.jobs)
-    print(res["table"])
-    print(f"written to {res['path']}")
+    """Command-line entry: ``python -m ancfdae.studies.flying2d [--quick] [--out DIR] [--jobs N]``."""
+    command_line(run, __doc__, argv)
 
 
 if __name__ == "__main__":

@@ -26,7 +26,7 @@ import pickle
 
 import numpy as np
 
-from ._common import Progress, markdown_table, output_dir, run_cases
+from ._common import command_line, Progress, markdown_table, output_dir, run_cases
 from ._flying import T_HAT, Case, available, b3_beam, simulate_case, steady_drift
 
 __all__ = ["run", "run_case", "UpdateAudit"]
@@ -207,16 +207,8 @@ def _table(rows, h, missing):
 
 
 def main(argv=None):
-    """Command-line entry: ``python -m ancfdae.studies.flying3d [--quick] [--jobs N]``."""
-    import argparse
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--quick", action="store_true")
-    p.add_argument("--out", default=None)
-    p.add_argument("--jobs", type=int, default=None)
-    args = p.parse_args(argv)
-    res = run(quick=args.quick, out=args.out, jobs=args.jobs)
-    print(res["table"])
-    print(f"written to {res['path']}")
+    """Command-line entry: ``python -m ancfdae.studies.flying3d [--quick] [--out DIR] [--jobs N]``."""
+    command_line(run, __doc__, argv)
 
 
 if __name__ == "__main__":
