@@ -165,3 +165,20 @@ def test_kernel_option_is_validated(cls):
         cls(STEEL, section, kernel="fortran")
     el = cls(STEEL, section, kernel="numpy")
     assert el.kernel_in_use == "numpy" and "kernel='numpy'" in repr(el)
+
+
+def test_compiled_be3d_moment_load_equals_reference_and_finite_differences():
+    """The dead-moment force and its q-derivative: compiled == reference, and df/dq by differences."""
+    el, beam = _beam("BE3D", n_el=3)
+    g = beam.geom
+    M = np.array([2e3, -1e3, 5e2])
+    pairs = []
+    for qe, _, _ in _states(beam, seed=8):
+        for e, s in ((0, -1.0), (1, 0.37), (2, 1.0)):
+            pairs.append(_both(el, lambda: el.moment_load(g, qe[e], s, M, e, True)))
+            f_only, none = el.moment_load(g, qe[e], s, M, e, False)
+            assert none is None and np.array_equal(f_only, pairs[-1][0][0])
+    _assert_equal_by_block(pairs, ["force", "tangent"])
+    qe = next(_states(beam, seed=9))[0][1] + 0.05
+    _, K = el.moment_load(g, qe, 0.37, M, 1, True)
+    assert rel_err(K, fd_gradient(lambda x: el.moment_load(g, x, 0.37, M, 1, False)[0], qe, h=1e-6)) < 1e-6

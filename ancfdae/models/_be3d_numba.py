@@ -31,7 +31,7 @@ N_SLOTS = 30
 N_LOC = 8
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def curvature_point(V, G, H, a, b, th, thp, d, dp, second):
     """Jets of ``(k1, k2, k3)`` over ``(a, b, theta, theta')`` in slots K1, K2, K3 (8 variables)."""
     n = N_LOC

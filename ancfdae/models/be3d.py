@@ -294,6 +294,12 @@ class BE3D(Element):
         ``f_r' = (M x e1)/|r'| + g (M . e1)`` and ``f_theta = M . e1``.
         """
         M = finite_vector("moment", moment, 3)
+        if self._impl == "numba":
+            from ._be3d_moment_numba import be3d_moment
+            D = geom["directors"]
+            f, K = be3d_moment(np.ascontiguousarray(q, dtype=float), _DOF, _THETA, float(s), float(geom["L"][element]),
+                               np.ascontiguousarray(D[element]), np.ascontiguousarray(D[element + 1]), M, bool(tangent))
+            return f, (K if tangent else None)
         L = geom["L"][[element]]
         s_ = np.array([float(s)])
         _, dN, _ = hermite(s_, L)
