@@ -22,18 +22,23 @@ from numba import njit
 from ._jet_numba import jmul, jrecip, jsqrt, jzero
 from ._thin_numba import slope
 
-__all__ = ["be3d_inertia", "be3d_inertia_element", "be3d_kinetic_energy"]
+__all__ = ["be3d_inertia", "be3d_inertia_element", "inertia_scratch", "be3d_kinetic_energy"]
 
 _P, _AD, _M2, _SP, _W, _R, _C = range(7)
 
 
+@njit(cache=True, inline="always")
+def spin_scratch(second):
+    """Work arrays of :func:`_spin_vector`: jet slots (V, G, H), a 3-vector and a 3x3 matrix."""
+    return np.zeros(7), np.zeros((7, 3)), np.zeros((7 if second else 1, 3, 3)), np.zeros(3), np.zeros((3, 3))
+
+
 @njit(cache=True)
-def _spin_vector(a, d, g, Gm, Hg, second):
-    """``g(a)``, ``G = dg/da`` and, if ``second``, ``Hg[i, j, k] = d2 g_i / da_j da_k`` at one point."""
-    V = np.zeros(7)
-    G = np.zeros((7, 3))
-    H = np.zeros((7 if second else 1, 3, 3))
-    m = np.empty(3)
+def _spin_vector(a, d, g, Gm, Hg, second, V, G, H, m, dm):
+    """``g(a)``, ``G = dg/da`` and, if ``second``, ``Hg[i, j, k] = d2 g_i / da_j da_k`` at one point.
+
+    ``V, G, H, m, dm``: work arrays from :func:`spin_scratch`.
+    """
     m[0] = d[1] * a[2] - d[2] * a[1]
     m[1] = d[2] * a[0] - d[0] * a[2]
     m[2] = d[0] * a[1] - d[1] * a[0]
@@ -57,7 +62,6 @@ def _spin_vector(a, d, g, Gm, Hg, second):
     jrecip(V, G, H, _R, _W, 3, second)
     jmul(V, G, H, _C, _AD, _R, 3, second)
     # dm/da = [d]_x
-    dm = np.zeros((3, 3))
     dm[0, 1], dm[0, 2] = -d[2], d[1]
     dm[1, 0], dm[1, 2] = d[2], -d[0]
     dm[2, 0], dm[2, 1] = -d[1], d[0]
@@ -91,12 +95,13 @@ def _bat_m_ba(out, dof, dN, M, scale):
 
 
 @njit(cache=True, inline="always")
-def _point_state(q, dof, theta, dN, l0, l1, dA, dB, a, d, w, g, Gm, Hg, second):
+def _point_state(q, dof, theta, dN, l0, l1, dA, dB, a, d, w, g, Gm, Hg, second, scratch):
     """Slope ``a``, director ``d``, ``g, G, Hg`` and the spin row ``w = N_theta + Ba^T g`` at a point."""
     slope(q, dof, dN, a)
     for i in range(3):
         d[i] = l0 * dA[i] + l1 * dB[i]
-    _spin_vector(a, d, g, Gm, Hg, second)
+    V, G, H, m, dm = scratch
+    _spin_vector(a, d, g, Gm, Hg, second, V, G, H, m, dm)
     w[:] = 0.0
     w[theta[0]] = l0
     w[theta[1]] = l1
@@ -104,27 +109,24 @@ def _point_state(q, dof, theta, dN, l0, l1, dA, dB, a, d, w, g, Gm, Hg, second):
 
 
 @njit(cache=True, inline="always")
-def be3d_inertia_element(f, Kq, Dv, Ma, q, v, acc, dof, theta, dN, wdx, lin, dA, dB, rhoJ, jacobian):
-    """One element: adds the rotary inertia force to ``f`` (14,) and, if ``jacobian``, df/dq, df/dv, df/da."""
+def inertia_scratch(n, jacobian):
+    """Work arrays of :func:`be3d_inertia_element` for ``n`` element coordinates."""
+    return ((np.empty(3), np.empty(3), np.empty(3), np.empty((3, 3)), np.empty((3, 3, 3)), np.empty(3),
+             np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty((3, 3))),
+            (np.empty(n), np.empty(n), np.empty(n), np.empty(n)), spin_scratch(jacobian))
+
+
+@njit(cache=True, inline="always")
+def be3d_inertia_element(f, Kq, Dv, Ma, q, v, acc, dof, theta, dN, wdx, lin, dA, dB, rhoJ, jacobian, work):
+    """One element: adds the rotary inertia force to ``f`` (14,) and, if ``jacobian``, df/dq, df/dv, df/da.
+
+    ``work`` from :func:`inertia_scratch`.
+    """
     n = q.size
-    a = np.empty(3)
-    d = np.empty(3)
-    g = np.empty(3)
-    Gm = np.empty((3, 3))
-    Hg = np.empty((3, 3, 3))
-    ad = np.empty(3)
-    add = np.empty(3)
-    Gad = np.empty(3)
-    x = np.empty(3)
-    y = np.empty(3)
-    M3 = np.empty((3, 3))
-    w = np.empty(n)
-    c = np.empty(n)
-    t = np.empty(n)
-    u = np.empty(n)
+    (a, d, g, Gm, Hg, ad, add, Gad, x, y, M3), (w, c, t, u), scratch = work
     for p in range(wdx.size):
         W = rhoJ * wdx[p]
-        _point_state(q, dof, theta, dN[p], lin[p, 0], lin[p, 1], dA, dB, a, d, w, g, Gm, Hg, jacobian)
+        _point_state(q, dof, theta, dN[p], lin[p, 0], lin[p, 1], dA, dB, a, d, w, g, Gm, Hg, jacobian, scratch)
         slope(v, dof, dN[p], ad)                       # a_dot
         om = 0.0
         wacc = 0.0
@@ -205,10 +207,11 @@ def be3d_inertia(q, v, acc, dof, theta, dN, wdx, lin, directors, rhoJ, jacobian)
     Kq = np.zeros((m, n, n))
     Dv = np.zeros((m, n, n))
     Ma = np.zeros((m, n, n))
+    work = inertia_scratch(n, jacobian)
     for e in range(n_el):
         j = e if jacobian else 0
         be3d_inertia_element(f[e], Kq[j], Dv[j], Ma[j], q[e], v[e], acc[e], dof, theta, dN[e], wdx[e], lin,
-                             directors[e], directors[e + 1], rhoJ, jacobian)
+                             directors[e], directors[e + 1], rhoJ, jacobian, work)
     if not jacobian:
         return f, Kq[:0], Dv[:0], Ma[:0]
     return f, Kq, Dv, Ma
@@ -225,10 +228,11 @@ def be3d_kinetic_energy(q, v, dof, theta, dN, wdx, lin, directors, rhoJ):
     Gm = np.empty((3, 3))
     Hg = np.empty((1, 3, 3))
     w = np.empty(n)
+    scratch = spin_scratch(False)
     for e in range(n_el):
         for p in range(wdx.shape[1]):
             _point_state(q[e], dof, theta, dN[e, p], lin[p, 0], lin[p, 1], directors[e], directors[e + 1],
-                         a, d, w, g, Gm, Hg, False)
+                         a, d, w, g, Gm, Hg, False, scratch)
             om = 0.0
             for r in range(n):
                 om += w[r] * v[e, r]

@@ -19,23 +19,28 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._jet_numba import jcos, jlin, jmul, jrecip, jsin, jsqrt, jzero
+from ._jet_numba import jlin, jmul, jrecip, jsqrt, jzero
 from ._thin_numba import axial_point, hermite_map, scatter, slope
 
-__all__ = ["be3d_forces", "be3d_element", "curvature_point", "N_SLOTS", "K1", "K2", "K3"]
+__all__ = ["be3d_forces", "be3d_element", "be3d_scratch", "curvature_point", "N_SLOTS", "K1", "K2", "K3"]
 
 # Jet slots: inputs, then intermediates, then the results k1, k2, k3.
-(P, AD, M2, AB, BD, T, TP, TH, THP, SP, SM, R1, X, N1, N2, NY, R2, Y, N3, N4, NT, R3, TAU, C, S,
- W1, W2, K1, K2, K3) = range(30)
-N_SLOTS = 30
+(P, AD, M2, AB, BD, T, TP, SP, SM, R1, X, N1, N2, NY, R2, Y, N3, N4, NT, R3, TAU, W1, W2, K1, K2, K3) = range(26)
+N_SLOTS = 26
 N_LOC = 8
 
 
 @njit(cache=True)
 def curvature_point(V, G, H, a, b, th, thp, d, dp, second):
-    """Jets of ``(k1, k2, k3)`` over ``(a, b, theta, theta')`` in slots K1, K2, K3 (8 variables)."""
-    n = N_LOC
-    for o in (P, AD, M2, AB, BD, T, TP, TH, THP):
+    """Jets of ``(k1, k2, k3)`` over ``(a, b, theta, theta')`` in slots K1, K2, K3 (8 variables).
+
+    ``X``, ``Y`` and ``tau0`` depend on ``(a, b)`` only: their jets run over
+    those six variables (36 Hessian entries, not 64); the angle enters
+    through ``cos``/``sin`` and ``theta'`` linearly, so the jets of the
+    ``k_i`` over all eight variables are written out from them at the end.
+    """
+    n = 6
+    for o in (P, AD, M2, AB, BD, T, TP):
         jzero(V, G, H, o, n, second)
     m0 = d[1] * a[2] - d[2] * a[1]          # m = d x a
     m1 = d[2] * a[0] - d[0] * a[2]
@@ -49,10 +54,6 @@ def curvature_point(V, G, H, a, b, th, thp, d, dp, second):
     V[BD] = b[0] * d[0] + b[1] * d[1] + b[2] * d[2]
     V[T] = b[0] * m0 + b[1] * m1 + b[2] * m2
     V[TP] = dp[0] * m0 + dp[1] * m1 + dp[2] * m2
-    V[TH] = th
-    V[THP] = thp
-    G[TH, 6] = 1.0
-    G[THP, 7] = 1.0
     # b x d and d' x d: gradients of b.(d x a) = a.(b x d) and d'.(d x a) in a
     G[T, 0] = b[1] * d[2] - b[2] * d[1]
     G[T, 1] = b[2] * d[0] - b[0] * d[2]
@@ -82,7 +83,6 @@ def curvature_point(V, G, H, a, b, th, thp, d, dp, second):
         H[T, 0, 5] = H[T, 5, 0] = -d[1]
         H[T, 1, 5] = H[T, 5, 1] = d[0]
         H[T, 2, 4] = H[T, 4, 2] = -d[0]
-    n = N_LOC
     jsqrt(V, G, H, SP, P, n, second)
     jsqrt(V, G, H, SM, M2, n, second)
     # X = t / (|m| |a|)
@@ -103,37 +103,54 @@ def curvature_point(V, G, H, a, b, th, thp, d, dp, second):
     jmul(V, G, H, W1, SP, M2, n, second)
     jrecip(V, G, H, R3, W1, n, second)
     jmul(V, G, H, TAU, NT, R3, n, second)
-    jcos(V, G, H, C, TH, n, second)
-    jsin(V, G, H, S, TH, n, second)
-    jlin(V, G, H, K1, 1.0, THP, -1.0, TAU, n, second)
-    jmul(V, G, H, W1, S, X, n, second)
-    jmul(V, G, H, W2, C, Y, n, second)
-    jlin(V, G, H, K2, 1.0, W1, -1.0, W2, n, second)
-    jmul(V, G, H, W1, C, X, n, second)
-    jmul(V, G, H, W2, S, Y, n, second)
-    jlin(V, G, H, K3, 1.0, W1, 1.0, W2, n, second)
+    # k1 = theta' - tau0, k2 = s X - c Y, k3 = c X + s Y over (a, b, theta, theta')
+    c, s = np.cos(th), np.sin(th)
+    for o in (K1, K2, K3):
+        jzero(V, G, H, o, N_LOC, second)
+    vx, vy = V[X], V[Y]
+    V[K1] = thp - V[TAU]
+    V[K2] = s * vx - c * vy
+    V[K3] = c * vx + s * vy
+    G[K1, 7] = 1.0
+    G[K2, 6] = V[K3]
+    G[K3, 6] = -V[K2]
+    for i in range(n):
+        G[K1, i] = -G[TAU, i]
+        G[K2, i] = s * G[X, i] - c * G[Y, i]
+        G[K3, i] = c * G[X, i] + s * G[Y, i]
+    if second:
+        for i in range(n):
+            h2 = c * G[X, i] + s * G[Y, i]          # d2 k2 / (d x_i d theta)
+            h3 = -s * G[X, i] + c * G[Y, i]         # d2 k3 / (d x_i d theta)
+            H[K2, i, 6] = H[K2, 6, i] = h2
+            H[K3, i, 6] = H[K3, 6, i] = h3
+            for j in range(n):
+                H[K1, i, j] = -H[TAU, i, j]
+                H[K2, i, j] = s * H[X, i, j] - c * H[Y, i, j]
+                H[K3, i, j] = c * H[X, i, j] + s * H[Y, i, j]
+        H[K2, 6, 6] = -V[K2]
+        H[K3, 6, 6] = -V[K3]
+
+
+@njit(cache=True, inline="always")
+def be3d_scratch(tangent):
+    """Work arrays of :func:`be3d_element` (allocated once per kernel call, not per element)."""
+    return (np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.zeros((N_LOC, 4), dtype=np.int64),
+            np.zeros((N_LOC, 4)), np.zeros(N_LOC), np.zeros((N_LOC, N_LOC)), np.zeros(N_SLOTS),
+            np.zeros((N_SLOTS, N_LOC)), np.zeros((N_SLOTS if tangent else 1, N_LOC, N_LOC)))
 
 
 @njit(cache=True, inline="always")
 def be3d_element(f, K, q, dof, theta, dNa, wa, slope_ref, dNb, ddNb, wb, lin, L, dA, dB, k_ref, Dk, EA,
-                 tangent):
+                 tangent, scratch):
     """One element: adds ``dU/dq`` to ``f`` (14,) and, if ``tangent``, the stiffness to ``K``; returns U.
 
     ``theta`` (2,): element coordinates of the nodal angles; ``lin`` (n_b, 2):
     the linear functions at the bending points; ``dA, dB``: the element's
-    nodal directors; ``k_ref`` (n_b, 3); ``Dk = (G J k_t, E I2, E I3)``.
+    nodal directors; ``k_ref`` (n_b, 3); ``Dk = (G J k_t, E I2, E I3)``;
+    ``scratch`` from :func:`be3d_scratch`.
     """
-    a = np.empty(3)
-    b = np.empty(3)
-    d = np.empty(3)
-    dp = np.empty(3)
-    idx = np.zeros((N_LOC, 4), dtype=np.int64)
-    coef = np.zeros((N_LOC, 4))
-    grad = np.zeros(N_LOC)
-    Hl = np.zeros((N_LOC, N_LOC))
-    V = np.zeros(N_SLOTS)
-    G = np.zeros((N_SLOTS, N_LOC))
-    H = np.zeros((N_SLOTS if tangent else 1, N_LOC, N_LOC))
+    a, b, d, dp, idx, coef, grad, Hl, V, G, H = scratch
     U = 0.0
     for p in range(wa.size):
         U += axial_point(f, K, q, dof, dNa[p], wa[p], slope_ref[p], EA, a, idx, coef, grad, Hl, tangent)
@@ -186,10 +203,11 @@ def be3d_forces(q, dof, theta, dNa, wa, slope_ref, dNb, ddNb, wb, lin, L, direct
     U = np.zeros(n_el)
     f = np.zeros((n_el, n))
     K = np.zeros((n_el, n, n) if tangent else (1, n, n))
+    scratch = be3d_scratch(tangent)
     for e in range(n_el):
         U[e] = be3d_element(f[e], K[e if tangent else 0], q[e], dof, theta, dNa[e], wa[e], slope_ref[e],
                             dNb[e], ddNb[e], wb[e], lin, L[e], directors[e], directors[e + 1], k_ref[e], Dk,
-                            EA, tangent)
+                            EA, tangent, scratch)
     if not tangent:
         K = K[:0]
     return U, f, K

@@ -14,7 +14,7 @@ from numba import njit
 
 from ._thin_numba import axial_point, hermite_map, scatter, slope
 
-__all__ = ["cable3d_forces", "cable3d_element"]
+__all__ = ["cable3d_forces", "cable3d_element", "cable3d_scratch"]
 
 
 @njit(cache=True, inline="always")
@@ -55,19 +55,21 @@ def _bending_point(f, K, q, dof, dN, ddN, wdx, EI, a, b, idx, coef, grad, H, tan
 
 
 @njit(cache=True, inline="always")
-def cable3d_element(f, K, q, dof, dNa, wa, slope_ref, dNb, ddNb, wb, EA, EI, tangent):
+def cable3d_scratch():
+    """Work arrays of :func:`cable3d_element` (allocated once per kernel call, not per element)."""
+    return (np.empty(3), np.empty(3), np.zeros((6, 4), dtype=np.int64), np.zeros((6, 4)), np.zeros(6),
+            np.zeros((6, 6)))
+
+
+@njit(cache=True, inline="always")
+def cable3d_element(f, K, q, dof, dNa, wa, slope_ref, dNb, ddNb, wb, EA, EI, tangent, scratch):
     """One element: adds ``dU/dq`` to ``f`` (12,) and, if ``tangent``, the stiffness to ``K`` (12, 12).
 
     ``dNa`` (n_a, 4), ``wa``, ``slope_ref`` (n_a,): the axial rule; ``dNb``,
-    ``ddNb`` (n_b, 4), ``wb`` (n_b,): the bending rule. Returns the element's
-    strain energy.
+    ``ddNb`` (n_b, 4), ``wb`` (n_b,): the bending rule; ``scratch`` from
+    :func:`cable3d_scratch`. Returns the element's strain energy.
     """
-    a = np.empty(3)
-    b = np.empty(3)
-    idx = np.zeros((6, 4), dtype=np.int64)
-    coef = np.zeros((6, 4))
-    grad = np.zeros(6)
-    H = np.zeros((6, 6))
+    a, b, idx, coef, grad, H = scratch
     U = 0.0
     for p in range(wa.size):
         U += axial_point(f, K, q, dof, dNa[p], wa[p], slope_ref[p], EA, a, idx, coef, grad, H, tangent)
@@ -86,9 +88,10 @@ def cable3d_forces(q, dof, dNa, wa, slope_ref, dNb, ddNb, wb, EA, EI, tangent):
     U = np.zeros(n_el)
     f = np.zeros((n_el, n))
     K = np.zeros((n_el, n, n) if tangent else (1, n, n))
+    scratch = cable3d_scratch()
     for e in range(n_el):
         U[e] = cable3d_element(f[e], K[e if tangent else 0], q[e], dof, dNa[e], wa[e], slope_ref[e],
-                               dNb[e], ddNb[e], wb[e], EA, EI, tangent)
+                               dNb[e], ddNb[e], wb[e], EA, EI, tangent, scratch)
     if not tangent:
         K = K[:0]
     return U, f, K
