@@ -8,7 +8,7 @@ from .materials import CircularSection, Material, RectangularSection, cowper_she
 from .problem import Energy, JacobianBlocks, Model
 from .static import StaticResult, solve_static
 from .simulate import METHODS, simulate
-from .result import Result
+from .result import Result, ResultFileError
 from .monitors import EnergyMonitor, PointSensor, Probe
 
 __version__ = "0.1.0"
@@ -18,5 +18,5 @@ __all__ = [
     "PointForce", "PointMoment", "Gravity", "DistributedLoad", "constant", "ramp", "pulse", "hat",
     "Model", "JacobianBlocks", "Energy",
     "solve_static", "StaticResult",
-    "simulate", "METHODS", "Result", "EnergyMonitor", "PointSensor", "Probe",
+    "simulate", "METHODS", "Result", "ResultFileError", "EnergyMonitor", "PointSensor", "Probe",
 ]

@@ -13,6 +13,7 @@ from ancfdae.integrators._base import FixedStepIntegrator
 from ancfdae.integrators.ida import IDA
 from ancfdae.integrators.lobatto import LobattoIIIA
 from ancfdae.integrators.newmark import GeneralizedAlpha, HHTAlpha, Newmark
+from ancfdae._resultfile import describe_model
 from ancfdae.result import Result
 
 __all__ = ["simulate", "METHODS"]
@@ -107,4 +108,7 @@ def simulate(model, t_span, method="lobatto3", h=None, t_eval=None, monitors=(),
         if h is not None:
             raise ValueError(f"`h` is not used by the variable-step method {method!r}; pass `max_step` instead.")
         integrator = cls(model, **options)
-    return integrator.run(t_span, t_eval=t_eval, monitors=monitors, hooks=hooks, q0=q0, v0=v0)
+    result = integrator.run(t_span, t_eval=t_eval, monitors=monitors, hooks=hooks, q0=q0, v0=v0)
+    if not result.model:   # the model's self-description, for self-describing result files
+        result.model = describe_model(model)
+    return result
