@@ -2,7 +2,12 @@
 
 The chapter cited throughout is Gerstmayr, Humer, Gruber, Nachbagauer, "The
 Absolute Nodal Coordinate Formulation" (Sects. 2-5, Eqs. 1-115).
+
+Submodules: :mod:`ancfdae.models` (elements and the beam), :mod:`ancfdae.integrators`,
+:mod:`ancfdae.export` (ParaView), :mod:`ancfdae.plot` (matplotlib pictures and animations).
 """
+import logging
+
 from .loads import DistributedLoad, Gravity, PointForce, PointMoment, constant, hat, pulse, ramp
 from .materials import CircularSection, Material, RectangularSection, cowper_shear_factor
 from .problem import Energy, JacobianBlocks, Model
@@ -12,6 +17,10 @@ from .result import Result, ResultFileError
 from .monitors import EnergyMonitor, PointSensor, Probe
 
 __version__ = "0.1.0"
+
+# The library reports through logging.getLogger("ancfdae") and prints nothing; by default its messages
+# go nowhere until the application configures logging.
+logging.getLogger("ancfdae").addHandler(logging.NullHandler())
 
 __all__ = [
     "Material", "RectangularSection", "CircularSection", "cowper_shear_factor",

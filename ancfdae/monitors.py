@@ -1,4 +1,4 @@
-"""Monitors: energy balance and point sensors, logged at the output times (design.md Sect. 6).
+"""Monitors: energy balance and point sensors, logged at the output times.
 
 Every integrator drives a monitor through four calls:
 
@@ -31,24 +31,60 @@ class Monitor:
 
     name = "monitor"
 
-    def start(self, model, t, q, v, a) -> None:  # noqa: D102
-        self.model = model
+    def start(self, model, t, q, v, a) -> None:
+        """Begin a run: the model and the initial state.
 
-    def advance(self, t, q, v, a, nodes=None) -> None:  # noqa: D102
-        pass
+        Parameters
+        ----------
+        model : Model
+        t : float
+        q, v, a : ndarray, shape (n_dof,)
+        """
 
-    def sample(self, t, q, v, a) -> None:  # noqa: D102
-        pass
+    def advance(self, t, q, v, a, nodes=None) -> None:
+        """Account for one accepted step ending at ``t``.
 
-    def log(self) -> dict:  # noqa: D102
+        Parameters
+        ----------
+        t : float
+        q, v, a : ndarray, shape (n_dof,)
+            State at the end of the step.
+        nodes : tuple, optional
+            ``(ts, Q, V, w)``: the step's quadrature (times, stage coordinates
+            and velocities as rows, weights summing to the step size).
+        """
+
+    def sample(self, t, q, v, a) -> None:
+        """Record the state at an output time (inside the last advanced step).
+
+        Parameters
+        ----------
+        t : float
+        q, v, a : ndarray, shape (n_dof,)
+        """
+
+    def log(self) -> dict:
+        """The recorded data: arrays with one entry per output time, and scalars.
+
+        Returns
+        -------
+        dict
+            Stored as ``Result.monitors[name]``.
+        """
         return {}
 
-    def stop_reason(self) -> str | None:  # noqa: D102
+    def stop_reason(self) -> str | None:
+        """A message when the monitor asks the run to end, else None.
+
+        Returns
+        -------
+        str or None
+        """
         return None
 
 
 class EnergyMonitor(Monitor):
-    """Energy balance ``E(t) = T + U + V - W_ext`` (design.md Sect. 6).
+    """Energy balance ``E(t) = T + U + V - W_ext`` logged at the output times.
 
     ``T, U, V`` come from ``model.energy`` (kinetic, strain, potential of the
     conservative loads). ``W_ext(t) = int_t0^t P_ext dt`` is the work of the
@@ -204,7 +240,15 @@ class PointSensor(Monitor):
 
 
 class Probe(Monitor):
-    """Any quantity ``function(t, q, v, a) -> array`` logged at the output times."""
+    """Any quantity logged at the output times.
+
+    Parameters
+    ----------
+    name : str
+        Key in ``Result.monitors``.
+    function : callable
+        ``function(t, q, v, a) -> array``, logged as ``"value"``.
+    """
 
     def __init__(self, name: str, function):
         if not callable(function):

@@ -4,7 +4,7 @@ An element type is a class with a few class attributes describing its node
 layout and methods that work on *all elements at once*: element coordinate
 arrays have shape ``(n_el, n_edof)`` and element matrices
 ``(n_el, n_edof, n_edof)``; kernels loop over neither elements nor quadrature
-points in Python (design.md Sect. 4).
+points in Python.
 
 Conventions
 -----------
@@ -35,8 +35,8 @@ __all__ = ["Element"]
 class Element(ABC):
     """Base class of the ANCF element types.
 
-    Class attributes
-    ----------------
+    Attributes
+    ----------
     name : str
         Short name used in tables ("BE2D", "SQ3D", ...).
     dim : int
@@ -50,10 +50,16 @@ class Element(ABC):
         False only for elements whose mass matrix depends on q (BE3D).
     formulations : tuple of str
         The formulation variants the element offers.
+    material : Material
+        Instance attribute, required: the beam reads ``rho`` from it.
+    section : RectangularSection or CircularSection
+        Instance attribute, required: the beam reads ``A`` from it.
 
-    Instance attributes ``material`` (:class:`ancfdae.materials.Material`)
-    and ``section`` (a section of :mod:`ancfdae.materials`) are required: the
-    beam reads ``rho * A`` from them for gravity.
+    Notes
+    -----
+    The attributes up to ``formulations`` are class attributes. Subclasses
+    keep every constructor option under its argument name, so that
+    :meth:`Beam.describe` records it and a result file can rebuild the element.
     """
 
     name: ClassVar[str]
@@ -103,7 +109,7 @@ class Element(ABC):
         ``kind`` is ``"clamp"`` (position and orientation) or ``"pin"``
         (position only). ``frame`` is the node's reference frame; elements
         use it to leave the axial stretch free at a clamp where that can be
-        done by fixing coordinates (benchmarks.md B1).
+        done by fixing coordinates (the cantilever of chapter Sect. 5.1).
         """
 
     @abstractmethod
