@@ -14,14 +14,20 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from typing import TYPE_CHECKING
+
 from ._sections import reference_points, section_outline, solid_points, wedge_cells
+
+if TYPE_CHECKING:
+    from .models import Beam
+    from .result import Result
 
 __all__ = ["vtk", "beam_of"]
 
 logger = logging.getLogger("ancfdae")
 
 
-def beam_of(result):
+def beam_of(result: Result) -> Beam:
     """The beam a result was computed with, rebuilt from the description in the result.
 
     Parameters
@@ -78,7 +84,7 @@ def _strains(beam, q_full_nodal, ref_nodal):
     return {"axial_strain": stretch - 1.0}
 
 
-def vtk(result, beam=None, directory: str | os.PathLike = ".", name: str = "beam",
+def vtk(result: Result, beam: Beam | None = None, directory: str | os.PathLike = ".", name: str = "beam",
         every: int = 1) -> Path:
     """Write the motion of a beam as ParaView files.
 

@@ -12,9 +12,18 @@ import logging
 import os
 from pathlib import Path
 
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ._sections import section_outline, section_vectors
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from .models import Beam
+    from .result import Result
 
 __all__ = ["configuration", "energy", "tip", "animate"]
 
@@ -36,7 +45,8 @@ def _check_q(beam, q):
     return q
 
 
-def configuration(beam, q, ax=None, *, directors=None, sections: bool = True, color=None):
+def configuration(beam: Beam, q: ArrayLike, ax: Axes | None = None, *, directors: np.ndarray | None = None,
+                  sections: bool = True, color: Any = None) -> Axes:
     """Draw a configuration of a beam: its axis and the outline of the solid.
 
     Parameters
@@ -100,7 +110,7 @@ def configuration(beam, q, ax=None, *, directors=None, sections: bool = True, co
     return ax
 
 
-def energy(result, ax=None, *, monitor: str = "energy"):
+def energy(result: Result, ax: Axes | None = None, *, monitor: str = "energy") -> Axes:
     """Plot the energies of an :class:`~ancfdae.EnergyMonitor` log over time.
 
     Parameters
@@ -129,7 +139,7 @@ def energy(result, ax=None, *, monitor: str = "energy"):
     return ax
 
 
-def tip(result, ax=None, *, beam=None, s=None):
+def tip(result: Result, ax: Axes | None = None, *, beam: Beam | None = None, s: float | None = None) -> Axes:
     """Plot the displacement components of a point of the axis (default the beam's end) over time.
 
     Parameters
@@ -165,7 +175,7 @@ def tip(result, ax=None, *, beam=None, s=None):
     return ax
 
 
-def animate(result, path: str | os.PathLike, *, beam=None, every: int = 1, fps: int = 20, dpi: int = 80) -> Path:
+def animate(result: Result, path: str | os.PathLike, *, beam: Beam | None = None, every: int = 1, fps: int = 20, dpi: int = 80) -> Path:
     """Write an animated GIF of the beam's motion.
 
     Parameters

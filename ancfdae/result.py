@@ -8,12 +8,16 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 from pathlib import Path
 
 import numpy as np
 
 from . import _resultfile
 from ._resultfile import ResultFileError
+
+if TYPE_CHECKING:
+    import xarray
 
 __all__ = ["Result", "ResultFileError"]
 
@@ -100,7 +104,7 @@ class Result:
                 f"n_dof={n_dof}, t={span}, message={self.message!r})")
 
     # -- persistence ------------------------------------------------------------------------
-    def to_xarray(self):
+    def to_xarray(self) -> "xarray.Dataset":
         """The result as a labelled :class:`xarray.Dataset` (what :meth:`save` writes).
 
         Dimensions ``time`` and ``dof`` with the coordinates ``node`` and

@@ -126,7 +126,7 @@ class Element(ABC):
 
     # -- kernels ------------------------------------------------------------
     @abstractmethod
-    def mass_matrix(self, geom) -> np.ndarray:
+    def mass_matrix(self, geom: Any) -> np.ndarray:
         """Constant element mass matrices, shape (n_el, n_edof, n_edof).
 
         For an element with ``mass_is_constant = False`` this is the constant
@@ -134,11 +134,11 @@ class Element(ABC):
         """
 
     @abstractmethod
-    def strain_energy(self, geom, q: np.ndarray) -> np.ndarray:
+    def strain_energy(self, geom: Any, q: np.ndarray) -> np.ndarray:
         """Strain energy of each element, shape (n_el,)."""
 
     @abstractmethod
-    def internal_forces(self, geom, q: np.ndarray, tangent: bool = True):
+    def internal_forces(self, geom: Any, q: np.ndarray, tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """``f = dU/dq_e`` and, if ``tangent``, ``K = d f / d q_e``.
 
         Returns
@@ -157,8 +157,8 @@ class Element(ABC):
         """
 
     @abstractmethod
-    def moment_load(self, geom, q: np.ndarray, s: float, moment: np.ndarray, element: int,
-                    tangent: bool = True):
+    def moment_load(self, geom: Any, q: np.ndarray, s: float, moment: np.ndarray, element: int,
+                    tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """Generalised force of a dead moment acting at axis point ``s`` of one element.
 
         The virtual work of a moment is ``M . delta phi`` with the virtual
@@ -180,7 +180,7 @@ class Element(ABC):
         """
 
     # -- optional: configuration-dependent inertia (BE3D) ------------------
-    def inertia(self, geom, q, v, a, jacobian: bool = True):
+    def inertia(self, geom: Any, q: np.ndarray, v: np.ndarray, a: np.ndarray, jacobian: bool = True) -> tuple:
         """Inertia forces beyond the constant mass matrix.
 
         Only for ``mass_is_constant = False``: returns ``f`` of shape
@@ -190,11 +190,11 @@ class Element(ABC):
         """
         raise NotImplementedError
 
-    def kinetic_energy_extra(self, geom, q, v) -> np.ndarray:
+    def kinetic_energy_extra(self, geom: Any, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Kinetic energy beyond ``1/2 v^T M_const v``, shape (n_el,)."""
         return np.zeros(len(q))
 
-    def accept_step(self, geom, Q: np.ndarray, V: np.ndarray):
+    def accept_step(self, geom: Any, Q: np.ndarray, V: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Hook after an accepted time or load step (BE3D director update).
 
         ``Q``, ``V``: full nodal coordinate and velocity arrays, shape
