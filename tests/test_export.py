@@ -20,7 +20,7 @@ def _run(element, force, t_end=0.02, record_directors=False):
         hooks = (lambda t, q, v, a: dirs.append(beam.geom["directors"].copy()),)
     res = simulate(beam, (0, t_end), "lobatto3", h=0.005, hooks=hooks)
     assert res.success, res.message
-    if record_directors:
+    if record_directors and "directors" not in res.model_state:   # integrators that do not record them yet
         res.model_state["directors"] = np.array(dirs)
     return beam, res
 
