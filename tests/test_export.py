@@ -92,8 +92,9 @@ def test_vtk_without_beam_rebuilds_it_from_the_result_file(tmp_path):
 
 def test_vtk_errors(tmp_path):
     beam, res = _run(BE3D(SOFT, RectangularSection(0.1)), [0.0, -20.0, 30.0])
+    no_state = Result(t=res.t, q=res.q, v=res.v, a=res.a, model=res.model)   # directors not recorded
     with pytest.raises(ValueError, match="model_state\\['directors'\\]"):
-        vtk(res, beam, tmp_path)
+        vtk(no_state, beam, tmp_path)
     bare = Result(t=res.t, q=res.q, v=res.v, a=res.a)
     with pytest.raises(ValueError, match="no beam description"):
         vtk(bare, None, tmp_path)
