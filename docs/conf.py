@@ -22,7 +22,6 @@ source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 exclude_patterns = ["_build", "api/generated/*.md"]
 templates_path = ["_templates"]
 autosummary_generate = True
-autodoc_default_options = {"members": False}
 autodoc_typehints = "none"          # numpydoc's Parameters sections carry the types
 numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
