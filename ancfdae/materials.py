@@ -19,7 +19,15 @@ __all__ = ["Material", "RectangularSection", "CircularSection", "cowper_shear_fa
 def cowper_shear_factor(nu: float) -> float:
     """Cowper's shear correction factor of a rectangle, chapter Eq. 112.
 
-    ``k_s = 10 (1 + nu) / (12 + 11 nu)``; 0.8496732026143791 for nu = 0.3.
+    Parameters
+    ----------
+    nu : float
+        Poisson's ratio.
+
+    Returns
+    -------
+    float
+        ``k_s = 10 (1 + nu) / (12 + 11 nu)``; 0.8496732026143791 for nu = 0.3.
     """
     return 10.0 * (1.0 + nu) / (12.0 + 11.0 * nu)
 
@@ -131,10 +139,19 @@ class RectangularSection:
 
 @dataclass(frozen=True)
 class CircularSection:
-    """Solid circular cross-section of diameter ``d``.
+    """Solid circular cross-section.
 
     ``k_t = 1`` (the polar moment is the torsion constant); the default shear
     factor is ``6 (1 + nu) / (7 + 6 nu)`` (Cowper, solid circle).
+
+    Parameters
+    ----------
+    d : float
+        Diameter (> 0).
+    shear_factor : float, optional
+        Shear correction factor ``k_s``; None selects Cowper's.
+    torsion_factor : float, optional
+        ``k_t``; None selects 1.
     """
 
     d: float
@@ -146,14 +163,17 @@ class CircularSection:
 
     @property
     def A(self) -> float:
+        """Area ``pi d^2 / 4``."""
         return math.pi * self.d**2 / 4.0
 
     @property
     def I2(self) -> float:
+        """``int zeta^2 dA = pi d^4 / 64``."""
         return math.pi * self.d**4 / 64.0
 
     @property
     def I3(self) -> float:
+        """``int eta^2 dA``, equal to ``I2``."""
         return self.I2
 
     @property
@@ -163,13 +183,26 @@ class CircularSection:
 
     @property
     def J(self) -> float:
+        """Polar moment ``I2 + I3``."""
         return self.I2 + self.I3
 
     def k_s(self, material: Material) -> float:
+        """Shear correction factor (Cowper's solid circle by default).
+
+        Parameters
+        ----------
+        material : Material
+            Its ``nu`` enters Cowper's factor.
+
+        Returns
+        -------
+        float
+        """
         if self.shear_factor is not None:
             return self.shear_factor
         return 6.0 * (1.0 + material.nu) / (7.0 + 6.0 * material.nu)
 
     @property
     def k_t(self) -> float:
+        """Torsion factor: 1 for a solid circle (the polar moment is the torsion constant)."""
         return 1.0 if self.torsion_factor is None else self.torsion_factor

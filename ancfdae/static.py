@@ -48,6 +48,7 @@ class StaticResult:
 
     @property
     def success(self) -> bool:
+        """True when every load step converged."""
         return self.status == "converged"
 
 

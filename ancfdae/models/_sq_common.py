@@ -70,7 +70,7 @@ class SQElement(Element):
         integration locks in shear here too: 3 points make one quadratic
         element 5 % too stiff in bending), 3 x 3 Gauss points over a
         rectangular section (exact for the quartic St. Venant-Kirchhoff
-        energy); ``{"axial": 3}`` is Chrono's full integration (benchmarks.md B4).
+        energy); ``{"axial": 3}`` is Project Chrono's full integration.
         """
         n = self.nodes
         if self.formulation == "structural":
@@ -179,7 +179,7 @@ class SQElement(Element):
         E, nu, G = mat.E, mat.nu, mat.G
         if self.dim == 3:
             lam = E * nu / ((1 + nu) * (1 - 2 * nu))
-            normal = lam * np.ones((3, 3)) + 2 * G * np.eye(3)          # Eq. 34, corrected (benchmarks.md)
+            normal = lam * np.ones((3, 3)) + 2 * G * np.eye(3)          # Eq. 34 as the standard isotropic law (the chapter's text lost its factors)
             shear = np.diag([G, k * G, k * G])                          # gamma_23, gamma_13, gamma_12
         else:
             Ep = E / (1 - nu**2)

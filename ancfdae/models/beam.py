@@ -16,6 +16,7 @@ import scipy.sparse as sp
 
 from ..loads import DistributedLoad, Gravity, PointForce, PointMoment
 from ..problem import Energy, JacobianBlocks
+from . import _describe
 from ._assembly import Assembler
 from ._element import Element
 from ._mesh import mesh_from_points, straight_mesh
@@ -73,6 +74,7 @@ class Beam:
         if not isinstance(element, Element):
             raise TypeError(f"`element` must be an ancfdae element (e.g. BE2D(...)), got {element!r}.")
         self.element = element
+        self.normal, self.loads = normal, tuple(loads)   # kept for describe()
         dim = element.dim
         npe = element.n_nodes
         if nodes is not None:
@@ -194,6 +196,16 @@ class Beam:
         """Axis position at reference arc length ``s`` (scalar -> (dim,), array -> (n, dim))."""
         r = (self.point_matrix(s) @ self.expand(q)).reshape(-1, self.element.dim)
         return r[0] if np.ndim(s) == 0 else r
+
+    def describe(self) -> dict:
+        """JSON-able description (element, material, section, mesh, supports, loads); see
+        :func:`ancfdae.models._describe.describe`."""
+        return _describe.describe(self)
+
+    def dof_labels(self) -> tuple[np.ndarray, np.ndarray]:
+        """Node index and coordinate name of each free coordinate; see
+        :func:`ancfdae.models._describe.dof_labels`."""
+        return _describe.dof_labels(self)
 
     # -- loads ------------------------------------------------------------
     def _setup_loads(self, loads):

@@ -52,7 +52,7 @@ class SQ3D(SQElement):
         ``2G E_23 dE_23``; ``T:dE`` of the isotropic law gives ``4G E_23 dE_23``,
         used here (it only matters for cross-section shear).
         ``"continuum"``: Green strain, St. Venant-Kirchhoff (Eqs. 28-36, Eq. 34
-        corrected: benchmarks.md), transverse shears with ``k_s``, with the
+        read as the standard isotropic law, whose factors the chapter's text lost), transverse shears with ``k_s``, with the
         Poisson-locking remedy of Eq. 108; ``"continuum-locking"`` without it.
     nodes : {3, 2}
         Quadratic (default, Eq. 107) or linear (Eq. 106) interpolation.
