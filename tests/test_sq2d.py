@@ -7,7 +7,12 @@ from ancfdae.models import SQ2D, Beam
 
 REF_SQ = np.array([-0.50946471774, 1.20882282955])        # chapter Eq. 113, SQ2D/SQ3D
 # chapter Table 2, SQ2D column: elements -> tip error (m)
-TABLE2_SQ2D = {2: 1.516e-2, 4: 1.327e-3, 8: 9.159e-5, 16: 5.874e-6, 32: 3.695e-7}
+TABLE2_SQ2D = {2: 1.516e-2, 4: 1.327e-3, 8: 9.159e-5, 16: 5.874e-6, 32: 3.695e-7, 64: 2.312e-8}
+# Newton iterations per B1 solve (10 load steps, full Newton from the previous step's solution,
+# max|r| / max|r_0| < 1e-8): a regression value measured with this code, the same for 2-64 elements
+# (per load step 5, 6, 6, 6, 6, 6, 6, 5, 5, 5). Table 2 gives 49 (SQ2D) and 55 (SQ3D); the difference
+# is explained in docs/elements.md (it is the Newton start, not quadrature, clamp or norm).
+B1_ITERATIONS_SQ = 56
 
 
 def cantilever(steel, square, n, **kw):
@@ -30,8 +35,9 @@ def test_b1_reproduces_table2_and_order_4(steel, square):
         assert e == pytest.approx(TABLE2_SQ2D[n], rel=1e-3), n
     order = -np.polyfit(np.log(list(errors)), np.log(list(errors.values())), 1)[0]
     assert 3.7 < order < 4.2
-    # Table 2 reports 49 (SQ2D) and 55 (SQ3D); full Newton here takes 56 for every mesh.
-    assert all(45 <= it <= 60 for it in iterations.values())
+    # Exact: a changed tangent (a wrong term of K slows Newton to linear convergence) or a changed
+    # stopping rule moves it; Table 2's own counts are not reproduced (docs/elements.md).
+    assert iterations == {n: B1_ITERATIONS_SQ for n in TABLE2_SQ2D}
 
 
 def test_b1_full_integration_does_not_reproduce_table2(steel, square):
