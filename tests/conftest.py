@@ -11,7 +11,7 @@ from ancfdae import Material, RectangularSection
 
 @pytest.fixture
 def steel():
-    """B1 material (benchmarks.md): E = 2.07e11, nu = 0.3, rho = 7800."""
+    """B1 material: E = 2.07e11, nu = 0.3 (chapter Sect. 5.1), rho = 7800 (steel; statics do not use it)."""
     return Material(E=2.07e11, nu=0.3, rho=7800.0)
 
 
