@@ -10,6 +10,7 @@ from scipy.linalg import LinAlgWarning
 
 from ._validate import positive_int
 from .integrators._newton import NewtonOptions, NewtonSolver, NewtonStats
+from ._scale import ROUNDOFF, force_scale
 from .problem import accept_step
 
 __all__ = ["solve_static", "StaticResult"]
@@ -49,43 +50,6 @@ class StaticResult:
         return self.status == "converged"
 
 
-#: Absolute floor = ROUNDOFF * eps * force_scale: a residual below it is round-off of the terms that
-#: cancel in the assembled forces. Set below the attainable level (measured on B1, 256 BE2D elements:
-#: max|r| stalls at 0.46 eps * force_scale) so that the stagnation test of the Newton solver, not the
-#: floor, ends a solve whose residual cannot fall further; at 1.0 that solve stopped one iteration
-#: early per load step and the tip moved 3.5e-9 m from the converged 4e-11 m error.
-ROUNDOFF = 0.1
-
-
-def force_scale(model, t: float, q: np.ndarray) -> float:
-    """The problem's own force scale at ``(t, q)``, in the residual's units.
-
-    ``max|K| * max|q| + max|r(t, q, 0, 0)|``: stiffness times coordinates
-    (the size of the terms that cancel in the elastic forces) plus the
-    static residual at ``q`` (the applied load, in the reference
-    configuration where the elastic forces vanish). It is independent of the
-    unit system: a 1 um fibre and a 100 m beam get their own scale.
-
-    Parameters
-    ----------
-    model : Model
-    t : float
-    q : ndarray, shape (n_dof,)
-
-    Returns
-    -------
-    float
-        Non-negative; ``ROUNDOFF * eps * force_scale`` is the absolute floor
-        below which a residual is round-off.
-    """
-    z = np.zeros_like(q)
-    K = model.jacobian(t, q, z, z).K
-    kmax = float(abs(K).max()) if K.shape[0] else 0.0
-    qmax = float(np.max(np.abs(q))) if q.size else 0.0
-    r = model.residual(t, q, z, z)
-    return kmax * qmax + (float(np.max(np.abs(r))) if r.size else 0.0)
-
-
 def solve_static(model, load_steps: int = 10, *, t: float = 0.0, q0=None, tol: float = 1e-8,
                  atol: float | None = None, max_iter: int = 25, jacobian: str = "full") -> StaticResult:
     """Solve ``r(t, q, 0, 0) = 0`` with the loads applied in uniform steps.
@@ -112,7 +76,7 @@ def solve_static(model, load_steps: int = 10, *, t: float = 0.0, q0=None, tol: f
     atol : float, optional
         Absolute floor in the residual's units. By default it is derived from
         round-off, ``ROUNDOFF * eps * force_scale(model, t, q0)`` at full load
-        (see :func:`force_scale`), never a fixed number of newtons: a 1e-10 N
+        (see :func:`ancfdae._scale.force_scale`), never a fixed number of newtons: a 1e-10 N
         tip load on a micro-fibre is then solved, not declared converged
         before the first iteration.
     max_iter, jacobian

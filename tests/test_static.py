@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from ancfdae import CircularSection, Gravity, Material, PointForce, RectangularSection, solve_static
-from ancfdae.static import force_scale
+from ancfdae._scale import force_scale
 from ancfdae.models import BE2D, Beam
 
 
@@ -95,6 +95,10 @@ def test_force_scale_is_unit_free(steel, square):
     s1 = force_scale(b1, 0.0, b1.initial_state()[0])
     s2 = force_scale(b2, 0.0, b2.initial_state()[0])
     assert s2 == pytest.approx(1e-6 * s1, rel=1e-12)
+    # with motion: the inertia forces count (M a), so a model at rest with large accelerations has a scale
+    q, v = b1.initial_state()
+    a = np.full_like(q, 1e3)
+    assert force_scale(b1, 0.0, q, v, a) > s1
 
 
 def test_unsupported_beam_fails_clearly_without_warning(steel, square):
