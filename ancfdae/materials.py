@@ -9,7 +9,10 @@ axis 3 (``int eta^2 dA``, bending in the (x, y) plane -- the planar case).
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field
+
+import numpy as np
 
 from ._validate import positive
 
@@ -51,10 +54,15 @@ class Material:
     rho: float
 
     def __post_init__(self):
-        positive("E", self.E)
-        positive("rho", self.rho)
-        if not (isinstance(self.nu, (int, float)) and 0.0 <= self.nu < 0.5):
-            raise ValueError(f"`nu` must be a number in [0, 0.5), got {self.nu!r}.")
+        # Stored as Python floats: numpy scalars (np.float32(0.3)) are numbers too, and a float32
+        # kept as is would carry single precision into every stiffness computed from it.
+        object.__setattr__(self, "E", positive("E", self.E))
+        object.__setattr__(self, "rho", positive("rho", self.rho))
+        nu = self.nu
+        if (isinstance(nu, bool) or not isinstance(nu, numbers.Real) or not np.isfinite(nu)
+                or not 0.0 <= nu < 0.5):
+            raise ValueError(f"`nu` must be a number in [0, 0.5), got {nu!r}.")
+        object.__setattr__(self, "nu", float(nu))
 
     @property
     def G(self) -> float:
@@ -67,6 +75,14 @@ def _saint_venant_rectangle(h: float, b: float, terms: int = 50) -> float:
     long, short = max(h, b), min(h, b)
     s = sum(math.tanh(n * math.pi * long / (2 * short)) / n**5 for n in range(1, 2 * terms, 2))
     return long * short**3 / 3.0 * (1.0 - 192.0 / math.pi**5 * short / long * s)
+
+
+def _optional_factors(section):
+    """Check the optional ``shear_factor`` and ``torsion_factor`` and store them as floats."""
+    for name in ("shear_factor", "torsion_factor"):
+        value = getattr(section, name)
+        if value is not None:
+            object.__setattr__(section, name, positive(name, value))
 
 
 @dataclass(frozen=True)
@@ -91,14 +107,11 @@ class RectangularSection:
     torsion_factor: float | None = None
 
     def __post_init__(self):
-        positive("h", self.h)
+        object.__setattr__(self, "h", positive("h", self.h))
         if self.b is None:
-            object.__setattr__(self, "b", float(self.h))
-        positive("b", self.b)
-        if self.shear_factor is not None:
-            positive("shear_factor", self.shear_factor)
-        if self.torsion_factor is not None:
-            positive("torsion_factor", self.torsion_factor)
+            object.__setattr__(self, "b", self.h)
+        object.__setattr__(self, "b", positive("b", self.b))
+        _optional_factors(self)
 
     @property
     def A(self) -> float:
@@ -159,7 +172,8 @@ class CircularSection:
     torsion_factor: float | None = None
 
     def __post_init__(self):
-        positive("d", self.d)
+        object.__setattr__(self, "d", positive("d", self.d))
+        _optional_factors(self)
 
     @property
     def A(self) -> float:

@@ -1,13 +1,17 @@
 """The integrators study in quick mode: a stable work-precision ordering and the observed orders."""
+import numpy as np
 import pytest
 
 from ancfdae.studies import integrators
+from conftest import check_panel, saved_figures, series, visible_axes
 
 
 @pytest.fixture(scope="module")
 def quick(tmp_path_factory):
     out = tmp_path_factory.mktemp("integrators")
-    return integrators.run(quick=True, out=out, jobs=2, progress=False)
+    with saved_figures() as figs:
+        res = integrators.run(quick=True, out=out, jobs=2, progress=False)
+    return dict(res, figures=figs)
 
 
 def _eps(quick, method):
@@ -48,7 +52,17 @@ def test_modified_and_full_newton_agree_and_count_their_work(quick):
 
 def test_writes_table_and_figure(quick):
     assert "Observed order" in (quick["path"] / "integrators.md").read_text()
-    assert (quick["path"] / "work_precision.png").stat().st_size > 10_000
+    # One work-precision curve per method: CPU time against eps_T of the table's rows.
+    (ax,) = visible_axes(quick["figures"]["work_precision.png"])
+    check_panel(ax, min_lines=6)
+    assert ax.get_xscale() == ax.get_yscale() == "log"
+    lines = series(ax)
+    methods = {r["method"] for r in quick["rows"] if r["model"] == "B2" and not r["tol_sweep"]}
+    assert methods <= set(lines)
+    for m in methods:
+        rows = [r for r in quick["rows"] if r["model"] == "B2" and r["method"] == m and not r["tol_sweep"]]
+        x, y = lines[m]
+        assert sorted(y) == sorted(r["eps_T"] for r in rows) and sorted(x) == sorted(r["cpu"] for r in rows)
 
 
 def test_rejects_unknown_method():

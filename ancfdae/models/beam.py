@@ -10,10 +10,12 @@ from __future__ import annotations
 
 import copy
 import numbers
+from collections.abc import Iterable, Mapping
 
 import numpy as np
 import scipy.sparse as sp
 
+from .._validate import check_shape
 from ..loads import DistributedLoad, Gravity, PointForce, PointMoment
 from ..problem import Energy, JacobianBlocks
 from . import _describe
@@ -50,8 +52,9 @@ class Beam:
     supports : dict, optional
         ``{node: kind}`` with kind ``"clamp"``, ``"pin"`` or a tuple of
         coordinate names of ``element.node_coordinates`` to fix. Negative
-        node indices count from the end.
-    loads : sequence, optional
+        node indices count from the end. Without supports the beam flies
+        freely (dynamics); a static solve then fails (singular stiffness).
+    loads : load or sequence of loads, optional
         :class:`~ancfdae.loads.PointForce`, :class:`~ancfdae.loads.PointMoment`,
         :class:`~ancfdae.loads.Gravity`, :class:`~ancfdae.loads.DistributedLoad`.
     initial_velocity : callable or array_like, optional
@@ -109,8 +112,14 @@ class Beam:
 
         # Supports: eliminate fixed coordinates.
         fixed = np.zeros(self.q_ref.size, dtype=bool)
+        if supports is not None and not isinstance(supports, Mapping):
+            raise TypeError(f"`supports` must be a dict {{node: kind}} with kind 'clamp', 'pin' or a tuple of "
+                            f"coordinate names, e.g. {{0: 'clamp'}}; got {supports!r}.")
         for node, kind in (supports or {}).items():
             i = self._node_index(node, "supports")
+            if not isinstance(kind, (str, tuple, list)):
+                raise ValueError(f"`supports` kind must be 'clamp', 'pin' or a tuple of coordinate names "
+                                 f"{element.node_coordinates}, got {kind!r} at node {node}.")
             if isinstance(kind, str):
                 if kind not in ("clamp", "pin"):
                     raise ValueError(f"`supports` kind must be 'clamp', 'pin' or a tuple of coordinate names "
@@ -136,6 +145,13 @@ class Beam:
         self._M_csr = self._asm.csr(self._M_data)   # constant-mass product M a, built once
         self._zero_data = np.zeros(self._asm.nnz)
         self.load_factor = 1.0
+        if isinstance(loads, (PointForce, PointMoment, Gravity, DistributedLoad)):
+            loads = (loads,)   # a single load is a sequence of one
+        elif loads is None:
+            loads = ()
+        elif not isinstance(loads, Iterable):
+            raise TypeError(f"`loads` must be a load or a sequence of loads (PointForce, PointMoment, Gravity, "
+                            f"DistributedLoad), got {loads!r}.")
         self._setup_loads(loads)
         # Gather of the element coordinates from (free q, fixed reference values) in one take.
         ext_of_full = free_of_full.copy()
@@ -194,6 +210,7 @@ class Beam:
 
     def position(self, q: np.ndarray, s) -> np.ndarray:
         """Axis position at reference arc length ``s`` (scalar -> (dim,), array -> (n, dim))."""
+        self._check(q)
         r = (self.point_matrix(s) @ self.expand(q)).reshape(-1, self.element.dim)
         return r[0] if np.ndim(s) == 0 else r
 
@@ -268,6 +285,17 @@ class Beam:
         return f, kdata
 
     # -- the Model contract -------------------------------------------------
+    def _check(self, q, v=None, a=None):
+        """Shape checks of the contract's arguments: a wrong length would otherwise assemble silently
+        into a wrong-sized residual or fail deep inside numpy."""
+        n = (self.n_dof,)
+        if np.shape(q) != n:
+            check_shape("q", q, n, f"n_dof = {self.n_dof}")
+        if v is not None and np.shape(v) != n:
+            check_shape("v", v, n, f"n_dof = {self.n_dof}")
+        if a is not None and np.shape(a) != n:
+            check_shape("a", a, n, f"n_dof = {self.n_dof}")
+
     def initial_state(self):
         """Reference configuration and the initial velocity."""
         return self.q_ref[self.free].copy(), self._v0.copy()
@@ -297,6 +325,8 @@ class Beam:
 
     def mass(self, q=None) -> sp.csr_matrix:
         """Mass matrix M(q) (constant unless the element says otherwise; ``q=None``: the reference state)."""
+        if q is not None:
+            self._check(q)
         if self.mass_is_constant:
             return self._asm.csr(self._M_data.copy())
         if q is None:
@@ -331,6 +361,7 @@ class Beam:
 
     def residual(self, t, q, v, a):
         """``r = M(q) a + f_int(q) [+ inertia(q, v, a)] - lambda f_ext(t, q)``."""
+        self._check(q, v, a)
         fe, _ = self.element.internal_forces(self.geom, self._element_q(q), False)
         r = self._asm.vector(fe) + self._M_csr @ a
         if not self.mass_is_constant:
@@ -344,6 +375,12 @@ class Beam:
         The element kernel runs once on the stages' elements stacked (a geometry for ``m`` copies of
         the mesh, prepared on first use), which halves the per-call overhead of small meshes.
         """
+        m = np.size(ts)
+        if np.ndim(ts) != 1 or np.shape(Q) != (self.n_dof, m) or np.shape(V) != (self.n_dof, m) \
+                or np.shape(A) != (self.n_dof, m):
+            check_shape("ts", ts, (m,), "one time per stage")
+            for name, X in (("Q", Q), ("V", V), ("A", A)):
+                check_shape(name, X, (self.n_dof, m), f"(n_dof, number of stages) = ({self.n_dof}, {m})")
         ts = np.asarray(ts, dtype=float)
         m = ts.size
         if not self.mass_is_constant:
@@ -377,6 +414,7 @@ class Beam:
 
     def residual_jacobian(self, t, q, v, a):
         """``(residual, jacobian)`` from one kernel pass (the fused path of full Newton)."""
+        self._check(q, v, a)
         fe, ke = self.element.internal_forces(self.geom, self._element_q(q), True)
         fext, kload = self._f_external(t, q, True)
         r = self._asm.vector(fe) + self._M_csr @ a - self.load_factor * fext
@@ -393,6 +431,7 @@ class Beam:
 
     def jacobian(self, t, q, v, a) -> JacobianBlocks:
         """Exact ``dr/dq``, ``dr/dv``, ``dr/da`` with one shared CSR pattern."""
+        self._check(q, v, a)
         _, ke = self.element.internal_forces(self.geom, self._element_q(q), True)
         K = self._asm.data(ke)
         kload = self._f_external(t, q, True)[1] if self._moments else None
@@ -407,6 +446,7 @@ class Beam:
 
     def energy(self, t, q, v) -> Energy:
         """Kinetic ``1/2 v^T M v`` (+ element extra), strain, gravity potential."""
+        self._check(q, v)
         T = 0.5 * v @ (self._M_csr @ v)
         if not self.mass_is_constant:
             qf, vf = self.expand(q), self._expand_v(v)
@@ -418,6 +458,7 @@ class Beam:
 
     def external_power(self, t, q, v) -> float:
         """Power of all loads except gravity (whose work is the potential)."""
+        self._check(q, v)
         f, _ = self._f_nonconservative(t, self.expand(q), False)
         return float(self.load_factor * f @ v)
 
