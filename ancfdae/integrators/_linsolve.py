@@ -1,10 +1,18 @@
-"""LU factorisations for the Newton iterations: banded LAPACK when the pattern allows.
+"""LU factorisations for the Newton iterations: banded LAPACK whenever the pattern is banded.
 
 Beam matrices with nodes numbered along the axis are banded with a half
 bandwidth of about two nodes' coordinates, independent of the mesh. LAPACK's
-banded LU (``dgbtrf``) then costs O(n b^2): measured 24 us against SuperLU's
-230 us for the 257-coordinate B1 tangent with 64 BE2D elements. The mapping
-from a CSR pattern to band storage is computed once per pattern and cached.
+banded LU (``dgbtrf``/``dgbtrs``, ``zgbtrf``/``zgbtrs`` for complex systems)
+then costs O(n b^2). Measured on this kind of machine (one thread, factor and
+solve with the copy into band storage): 10.7 us against dense LAPACK's 62 us
+and SuperLU's 81-91 us for a 68-coordinate BE2D system (half bandwidth 7),
+and it stays ahead of dense LU even where the band fills the whole matrix
+(n = 27, half bandwidth 26: 7.3 us against 20.8 us), because scipy's dense
+``lu_factor`` costs more to call than LAPACK needs to work. A compiled banded
+LU (numba, the same elimination as ``dgbtf2``) was measured as well: equal at
+half bandwidth 7, 1.7-2.2 times slower at 26 and 53 (``benchmarks/banded_lu.py``),
+so LAPACK stays. The mapping from a CSR pattern to band storage is computed
+once per pattern and cached.
 """
 from __future__ import annotations
 
@@ -16,26 +24,30 @@ import scipy.sparse.linalg as spla
 
 __all__ = ["factorize"]
 
-#: Use dense LAPACK LU below this size (no sparse bookkeeping pays off).
-DENSE_MAX = 64
-#: Use the banded LU when the band (2 kl + ku + 1 rows) is at most this fraction of n.
+#: Up to this size every sparse matrix is factorised as banded, whatever its bandwidth (banded
+#: LAPACK was faster than dense LAPACK at every width measured there).
+SMALL = 200
+#: Above ``SMALL``: banded while the band storage rows ``2 kl + ku + 1`` are at most this fraction
+#: of ``n``, otherwise SuperLU.
 BAND_FRACTION = 0.25
 
 _band_cache: dict = {}
 
 
 def _band_map(indptr, indices, n):
+    """(kl, ku, ldab, flat, unique) of a CSR pattern, cached by the identity of its arrays."""
     key = (id(indptr), id(indices), n)
     hit = _band_cache.get(key)
     if hit is not None and hit[0] is indptr and hit[1] is indices:
         return hit[2]
     rows = np.repeat(np.arange(n), np.diff(indptr))
     off = rows - indices
-    kl, ku = int(max(off.max(), 0)), int(max(-off.min(), 0))
+    kl, ku = (int(max(off.max(), 0)), int(max(-off.min(), 0))) if off.size else (0, 0)
     ldab = 2 * kl + ku + 1
     # Fortran-ordered band storage of dgbtrf: ab[kl + ku + i - j, j].
     flat = (kl + ku + rows - indices) + indices.astype(np.int64) * ldab
-    info = (kl, ku, ldab, flat)
+    unique = np.unique(flat).size == flat.size
+    info = (kl, ku, ldab, flat, unique)
     if len(_band_cache) > 32:
         _band_cache.clear()
     _band_cache[key] = (indptr, indices, info)
@@ -51,17 +63,21 @@ class _Dense:
 
 
 class _Banded:
-    def __init__(self, csr, band):
-        kl, ku, ldab, flat = band
-        n = csr.shape[0]
-        ab = np.zeros(ldab * n)
-        np.add.at(ab, flat, csr.data) if not csr.has_canonical_format else ab.__setitem__(flat, csr.data)
+    def __init__(self, data, band, n):
+        kl, ku, ldab, flat, unique = band
+        cplx = np.iscomplexobj(data)
+        ab = np.zeros(ldab * n, dtype=complex if cplx else float)
+        if unique:
+            ab[flat] = data
+        else:
+            np.add.at(ab, flat, data)
+        trf, self._trs = (lapack.zgbtrf, lapack.zgbtrs) if cplx else (lapack.dgbtrf, lapack.dgbtrs)
         self.kl, self.ku = kl, ku
-        self.lub, self.piv, info = lapack.dgbtrf(ab.reshape((ldab, n), order="F"), kl, ku, overwrite_ab=1)
+        self.lub, self.piv, info = trf(ab.reshape((ldab, n), order="F"), kl, ku, overwrite_ab=1)
         self.singular = info > 0
 
     def solve(self, rhs):
-        x, _ = lapack.dgbtrs(self.lub, self.kl, self.ku, rhs, self.piv)
+        x, _ = self._trs(self.lub, self.kl, self.ku, rhs, self.piv)
         return x
 
 
@@ -76,22 +92,25 @@ class _SuperLU:
 def factorize(matrix):
     """LU-factorise a square dense array or sparse matrix; returns an object with ``solve(rhs)``.
 
-    A singular banded or dense matrix gives ``inf``/``nan`` in the solution
-    (the Newton solver reports that as a non-finite correction); SuperLU
-    raises RuntimeError for an exactly singular matrix.
+    Sparse matrices go to LAPACK's banded LU, real or complex, when small
+    (``n <= SMALL``) or narrow-banded (``BAND_FRACTION``), otherwise to
+    SuperLU; dense arrays to dense LAPACK. A singular banded or dense matrix gives
+    ``inf``/``nan`` in the solution (the Newton solver reports that as a
+    non-finite correction); SuperLU raises RuntimeError for an exactly
+    singular matrix.
     """
     if not sp.issparse(matrix):
-        arr = np.asarray(matrix, dtype=float)
+        arr = np.asarray(matrix)
+        if not np.iscomplexobj(arr):
+            arr = arr.astype(float, copy=False)
         if arr.ndim != 2 or arr.shape[0] != arr.shape[1]:
             raise ValueError(f"the Jacobian must be a square matrix, got shape {arr.shape}.")
         return _Dense(arr)
     n = matrix.shape[0]
     if matrix.shape[0] != matrix.shape[1]:
         raise ValueError(f"the Jacobian must be a square matrix, got shape {matrix.shape}.")
-    if n <= DENSE_MAX:
-        return _Dense(matrix.toarray())
     csr = matrix if sp.isspmatrix_csr(matrix) else sp.csr_matrix(matrix)
     band = _band_map(csr.indptr, csr.indices, n)
-    if band[2] <= BAND_FRACTION * n:
-        return _Banded(csr, band)
+    if n <= SMALL or band[2] <= BAND_FRACTION * n:
+        return _Banded(csr.data, band, n)
     return _SuperLU(csr)
