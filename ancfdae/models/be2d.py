@@ -287,19 +287,20 @@ class BE2D(Element):
 
     def _numba_args(self, geom):
         """The compiled module and the kernel's arguments after ``q`` (cached in the geometry)."""
-        from . import _be2d_numba as nb   # imports numba: only once the compiled kernel is selected
-        args = geom.get("_numba")
-        if args is None:   # C-contiguous float copies for the compiled loop, once per geometry
+        hit = geom.get("_numba")
+        if hit is None:   # C-contiguous float copies for the compiled loop, once per geometry
+            from . import _be2d_numba as nb   # imports numba: only once the compiled kernel is selected
             form = nb.STRUCTURAL if self.formulation == "structural" else nb.CONTINUUM
             E, sec = self.material.E, self.section
-            args = geom["_numba"] = tuple(np.ascontiguousarray(geom[k], dtype=float)
-                                          for k in ("dN_e", "ddN_e", "w", "eps_ref", "K_ref")) + (
+            args = tuple(np.ascontiguousarray(geom[k], dtype=float)
+                         for k in ("dN_e", "ddN_e", "w", "eps_ref", "K_ref")) + (
                 geom["n_a"], form, E * sec.A, E, sec.I3, sec.I4)
-        return nb, args
+            hit = geom["_numba"] = (nb, args, (nb.be2d_fused, args))
+        return hit
 
     def _internal_forces_numba(self, geom, q, tangent):
         """The compiled kernel; imported (and numba with it) on first use."""
-        nb, args = self._numba_args(geom)
+        nb, args, _ = self._numba_args(geom)
         f, K = nb.be2d_forces(np.ascontiguousarray(q, dtype=float), *args, bool(tangent))
         return f, (K if tangent else None)
 
@@ -307,8 +308,7 @@ class BE2D(Element):
         """``(be2d_fused, args)`` with the compiled kernel selected, else None (see :class:`Element`)."""
         if self._impl != "numba":
             return None
-        nb, args = self._numba_args(geom)
-        return nb.be2d_fused, args
+        return self._numba_args(geom)[2]
 
     def shape_matrix(self, s, lengths):
         N, _, _ = hermite(np.asarray(s, dtype=float), lengths)
