@@ -5,9 +5,11 @@ wall time of ``solve_static`` (model built outside the timed part), the tip erro
 Eq. 113, Newton iterations, and -- when exudyn is importable (``pip install ".[benchmark]"``) --
 Exudyn's ObjectANCFCable2D on the same problem (its ANCFcantileverTest setup, EigenSparse, one
 thread) and the ratio ancfdae / Exudyn (< 1: ancfdae faster). ``--element SQ3D`` compares with
-Exudyn's ObjectANCFBeam (shear deformable, linear: the nearest it has) and then prints the speed
-ratio at equal tip error (the coarsest SQ3D mesh at least as accurate as each Exudyn mesh);
-``--nodes 2`` runs the linear SQ3D, the same element as ObjectANCFBeam.
+Exudyn's ObjectBeamGeometricallyExact (Simo-Reissner beam, its strongest 3D beam; ``--peer
+SQ3D-ancfbeam``: its linear ObjectANCFBeam), ``--element SQ2D`` with ObjectBeamGeometricallyExact2D;
+after the table, the speed ratio at equal tip error (the coarsest mesh of ours at least as accurate
+as each Exudyn mesh) is printed; ``--nodes 2`` runs the linear SQ3D, the same element as
+ObjectANCFBeam.
 
 Exudyn is run with a stopping rule equivalent to ours ("ours"); where that cannot converge (its
 residual round-off floor lies above the absolute tolerance beyond ~128 elements) with its own
@@ -31,7 +33,9 @@ from . import _exudyn_peer as peer
 
 #: Exudyn's counterpart of each element type (runner(n, repeats, criterion)).
 PEERS = {"BE2D": peer.cantilever_be2d,
-         "SQ3D": peer.cantilever_beam3d}
+         "SQ3D": peer.cantilever_ge3d,
+         "SQ3D-ancfbeam": peer.cantilever_beam3d,
+         "SQ2D": peer.cantilever_ge2d}
 
 
 #: Exudyn's stopping rules, tried in this order until one converges (module docstring).
@@ -102,6 +106,10 @@ def main(argv=None):
     p.add_argument("--max-elements", type=int, default=1024)
     p.add_argument("--meshes", type=int, nargs="+", default=None, help="explicit element counts")
     p.add_argument("--element", default="BE2D")
+    p.add_argument("--peer", default=None, choices=sorted(PEERS),
+                   help="Exudyn element to compare with (default: the element's own entry: BE2D -> "
+                        "ANCFCable2D, SQ3D -> BeamGeometricallyExact, SQ2D -> BeamGeometricallyExact2D; "
+                        "SQ3D-ancfbeam -> ANCFBeam)")
     p.add_argument("--nodes", type=int, default=None, help="SQ elements: 3 (quadratic, default) or 2 (linear)")
     p.add_argument("--kernel", default=None, choices=["auto", "numpy", "numba"], help="element kernel option")
     args = p.parse_args(argv)
@@ -115,7 +123,7 @@ def main(argv=None):
     print(f"{'n_el':>5} {'ours wall':>10} {'cpu':>9} {'error':>10} {'its':>4} | {'Exudyn wall':>11} {'cpu':>9} "
           f"{'error':>10} {'its':>4} {'rule':>8} | {'ratio':>6}")
     for n in meshes:
-        a, e = interleaved(args.element, n, args.repeats, PEERS.get(args.element), options)
+        a, e = interleaved(args.element, n, args.repeats, PEERS.get(args.peer or args.element), options)
         rows.append((n, a, e))
         if e is None:
             ex = f"{'-':>11} {'-':>9} {'-':>10} {'-':>4} {'-':>8} | {'-':>6}"
