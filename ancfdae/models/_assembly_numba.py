@@ -58,3 +58,21 @@ def finish_residual(r, m_data, indptr, indices, a, lam, f_ext):
         for jj in range(indptr[i], indptr[i + 1]):
             s += m_data[jj] * a[indices[jj]]
         r[i] = (r[i] + s) - lam * f_ext[i]
+
+
+@njit(cache=True)
+def finish_stages(F, m_data, indptr, indices, A, lam, f_ext, R):
+    """``R[i, k] = (F[k, i] + (M A)[i, k]) - lam * f_ext[i, k]`` for the stages ``k``.
+
+    ``F`` (m, n + 1): the stages' assembled forces (last column: fixed bin);
+    ``A``, ``f_ext``, ``R`` (n, m). Rounds as ``F.T + M @ A - lam * f_ext`` with
+    scipy (its CSR times dense matrix accumulates row by row in pattern order).
+    """
+    n = indptr.size - 1
+    m = A.shape[1]
+    for i in range(n):
+        for k in range(m):
+            s = 0.0
+            for jj in range(indptr[i], indptr[i + 1]):
+                s += m_data[jj] * A[indices[jj], k]
+            R[i, k] = (F[k, i] + s) - lam * f_ext[i, k]

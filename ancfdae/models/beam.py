@@ -8,6 +8,7 @@ its iteration matrix by combining data arrays.
 """
 from __future__ import annotations
 
+import functools
 import numbers
 
 import numpy as np
@@ -23,16 +24,18 @@ from ._quadrature import gauss
 __all__ = ["Beam"]
 
 
+@functools.cache
 def _finish_residual():
     """The compiled ``f + M a - lambda f_ext`` (imports numba: only reached on the fused path)."""
-    global _FINISH
-    if _FINISH is None:
-        from ._assembly_numba import finish_residual
-        _FINISH = finish_residual
-    return _FINISH
+    from ._assembly_numba import finish_residual
+    return finish_residual
 
 
-_FINISH = None
+@functools.cache
+def _finish_stages():
+    """The compiled stage version of :func:`_finish_residual`."""
+    from ._assembly_numba import finish_stages
+    return finish_stages
 
 
 class Beam:
@@ -375,8 +378,7 @@ class Beam:
     def _static_residual(self, a, f, fext, fused):
         """``f + M a - lambda f_ext`` (in place in ``f`` on the fused path: the same rounding)."""
         if fused:
-            finish_residual = _finish_residual()
-            finish_residual(f, self._M_data, self._asm.indptr, self._asm.indices,
+            _finish_residual()(f, self._M_data, self._asm.indptr, self._asm.indices,
                             np.ascontiguousarray(a, dtype=float), float(self.load_factor),
                             np.ascontiguousarray(fext, dtype=float))
             return f
@@ -410,18 +412,25 @@ class Beam:
             ext[n:] = self._q_fixed[:, None]
             fe, _ = self.element.internal_forces(geom, ext.ravel().take(gather), False)
             F = np.bincount(idx, weights=fe.ravel(), minlength=m * (n + 1))
-        else:
-            fn, args = fused
-            F = np.empty(m * (n + 1))
-            fn(np.ascontiguousarray(Q, dtype=float).ravel(), np.repeat(self._q_fixed, m), gather, idx,
-               self._asm._slot_all, False, F, self._no_k, *args)
-        F = F.reshape(m, n + 1)[:, :n].T
-        R = F + self._M_csr @ A
+            F = F.reshape(m, n + 1)[:, :n].T
+            R = F + self._M_csr @ A
+            if not self._dead and not self._moments:
+                R -= self.load_factor * self._f_gravity[:, None]
+            else:
+                for i in range(m):
+                    R[:, i] -= self.load_factor * self._f_external(ts[i], Q[:, i], False)[0]
+            return R
+        fn, args = fused
+        F = np.empty((m, n + 1))
+        fn(np.ascontiguousarray(Q, dtype=float).ravel(), np.repeat(self._q_fixed, m), gather, idx,
+           self._asm._slot_all, False, F.reshape(-1), self._no_k, *args)
         if not self._dead and not self._moments:
-            R -= self.load_factor * self._f_gravity[:, None]
+            fext = np.broadcast_to(self._f_gravity[:, None], (n, m))
         else:
-            for i in range(m):
-                R[:, i] -= self.load_factor * self._f_external(ts[i], Q[:, i], False)[0]
+            fext = np.column_stack([self._f_external(ts[i], Q[:, i], False)[0] for i in range(m)])
+        R = np.empty((n, m))
+        _finish_stages()(F, self._M_data, self._asm.indptr, self._asm.indices, np.ascontiguousarray(A, dtype=float),
+                         float(self.load_factor), fext, R)
         return R
 
     def _stage_geometry(self, m):
