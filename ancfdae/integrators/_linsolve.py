@@ -22,7 +22,7 @@ import scipy.linalg.lapack as lapack
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-__all__ = ["factorize"]
+__all__ = ["factorize", "StageMatrix"]
 
 #: Up to this size every sparse matrix is factorised as banded, whatever its bandwidth (banded
 #: LAPACK was faster than dense LAPACK at every width measured there).
@@ -89,16 +89,103 @@ class _SuperLU:
         return self.lu.solve(rhs)
 
 
+class StageMatrix:
+    """The Newton matrix of an implicit Runge-Kutta step with one set of Jacobian blocks.
+
+    For stage accelerations ``X`` (n, m) stored interleaved (``x = X.ravel()``)
+    and blocks ``K, D, M`` evaluated at one state, the matrix of the stage
+    residuals ``r_i = r(t_i, Q_i, V_i, X_i)`` with ``V = V0 + h X A^T``,
+    ``Q = Q0 + h^2 X (A^2)^T`` acts as::
+
+        J(dX) = M dX + h D dX A^T + h^2 K dX (A^T)^2.
+
+    With the eigendecomposition ``A^T = S diag(lam) S^-1`` and ``dX = Y S^-1``
+    it splits into ``m`` independent n x n systems
+    ``(M + h lam_j D + h^2 lam_j^2 K) y_j = (R S)_j`` (as Radau codes do for
+    first-order systems). A complex-conjugate pair of eigenvalues (Lobatto
+    IIIA-3: ``lam = 1/4 +- i/sqrt(48)``) needs one complex factorisation, the
+    other solution being its conjugate: one complex n x n banded LU instead of
+    a real 2n x 2n one with twice the bandwidth, about half the work, and one
+    set of blocks to evaluate instead of one per stage.
+
+    Parameters
+    ----------
+    blocks : JacobianBlocks
+        ``K, D, M`` as CSR matrices sharing one pattern (``same_pattern``).
+    h : float
+        Step size.
+    a : ndarray, shape (m, m)
+        The implicit part of the tableau (the rows and columns of the implicit stages).
+    """
+
+    def __init__(self, blocks, h, a):
+        if not getattr(blocks, "same_pattern", False):
+            raise ValueError("`blocks` must share one CSR pattern (same_pattern=True) for StageMatrix.")
+        self.blocks, self.h = blocks, float(h)
+        a = np.asarray(a, dtype=float)
+        lam, S = np.linalg.eig(a.T)
+        self.m = a.shape[0]
+        self.lam, self.S, self.Sinv = lam, S, np.linalg.inv(S)
+
+    def factorize(self):
+        """Factorise the m (or fewer, for conjugate pairs) systems; returns an object with ``solve(r)``."""
+        return _StageFactors(self)
+
+
+class _StageFactors:
+    def __init__(self, sm):
+        b, h = sm.blocks, sm.h
+        K, D, M = b.K, b.D, b.M
+        self.m, self.S, self.Sinv = sm.m, sm.S, sm.Sinv
+        self.plan = []   # (j, factor or None, conjugate-of index)
+        self._complex = {}
+        done = {}
+        for j, lam in enumerate(sm.lam):
+            twin = next((k for k, l2 in done.items() if abs(np.conj(l2) - lam) <= 1e-14 * abs(lam)
+                         and abs(lam.imag) > 0), None)
+            if twin is not None:
+                self.plan.append((j, None, twin))
+                continue
+            self._complex[j] = abs(lam.imag) > 0
+            if self._complex[j]:
+                data = M.data + (h * lam) * D.data + (h * h * lam * lam) * K.data
+            else:
+                lr = lam.real
+                data = M.data + (h * lr) * D.data + (h * h * lr * lr) * K.data
+            csr = sp.csr_matrix((data, K.indices, K.indptr), shape=K.shape)
+            self.plan.append((j, factorize(csr), None))
+            done[j] = lam
+        self.singular = any(getattr(f, "singular", False) for _, f, _ in self.plan if f is not None)
+
+    def solve(self, rhs):
+        m = self.m
+        R = np.asarray(rhs).reshape(-1, m)
+        RS = R @ self.S                                       # (n, m) complex
+        Y = np.empty(RS.shape, dtype=complex)
+        for j, lu, twin in self.plan:
+            if lu is None:
+                continue
+            rj = np.ascontiguousarray(RS[:, j])
+            Y[:, j] = lu.solve(rj) if self._complex[j] else lu.solve(rj.real) + 1j * lu.solve(rj.imag)
+        for j, lu, twin in self.plan:
+            if lu is None:
+                Y[:, j] = np.conj(Y[:, twin])
+        return (Y @ self.Sinv).real.ravel()
+
+
 def factorize(matrix):
     """LU-factorise a square dense array or sparse matrix; returns an object with ``solve(rhs)``.
 
-    Sparse matrices go to LAPACK's banded LU, real or complex, when small
+    A :class:`StageMatrix` factorises in its eigenbasis. Sparse matrices go
+    to LAPACK's banded LU, real or complex, when small
     (``n <= SMALL``) or narrow-banded (``BAND_FRACTION``), otherwise to
     SuperLU; dense arrays to dense LAPACK. A singular banded or dense matrix gives
     ``inf``/``nan`` in the solution (the Newton solver reports that as a
     non-finite correction); SuperLU raises RuntimeError for an exactly
     singular matrix.
     """
+    if isinstance(matrix, StageMatrix):
+        return matrix.factorize()
     if not sp.issparse(matrix):
         arr = np.asarray(matrix)
         if not np.iscomplexobj(arr):
