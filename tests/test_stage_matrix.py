@@ -44,7 +44,7 @@ def test_eigenbasis_solve_equals_interleaved_solve(a, h):
     x_ref = spla.spsolve(_interleaved(blocks, h, a), r)
     x = factorize(StageMatrix(blocks, h, a)).solve(r)
     assert x.dtype == float
-    assert np.abs(x - x_ref).max() <= 1e-10 * np.abs(x_ref).max()
+    assert np.abs(x - x_ref).max() <= 1e-12 * np.abs(x_ref).max()   # round-off (measured 3e-15 - 9e-15)
 
 
 def test_stage_matrix_needs_shared_pattern():
