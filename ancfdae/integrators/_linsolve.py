@@ -16,6 +16,8 @@ once per pattern and cached.
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import scipy.linalg as sla
 import scipy.linalg.lapack as lapack
@@ -23,6 +25,10 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 __all__ = ["factorize", "StageMatrix"]
+
+#: Substitute with the compiled loop (``_linsolve_numba``) up to this ``kl + ku``; LAPACK's
+#: ``dgbtrs`` above (equal at 30, faster at 52 and more: ``benchmarks/banded_lu.py``).
+COMPILED_SOLVE_MAX = 20
 
 #: Up to this size every sparse matrix is factorised as banded, whatever its bandwidth (banded
 #: LAPACK was faster than dense LAPACK at every width measured there).
@@ -54,6 +60,18 @@ def _band_map(indptr, indices, n):
     return info
 
 
+@functools.cache
+def _band_solve():
+    from ._linsolve_numba import band_solve
+    return band_solve
+
+
+@functools.cache
+def _pair_solve():
+    from ._linsolve_numba import pair_solve
+    return pair_solve
+
+
 class _Dense:
     def __init__(self, a):
         self.lu = sla.lu_factor(a, check_finite=False)
@@ -72,11 +90,16 @@ class _Banded:
         else:
             np.add.at(ab, flat, data)
         trf, self._trs = (lapack.zgbtrf, lapack.zgbtrs) if cplx else (lapack.dgbtrf, lapack.dgbtrs)
-        self.kl, self.ku = kl, ku
+        self.kl, self.ku, self.dtype = kl, ku, ab.dtype
         self.lub, self.piv, info = trf(ab.reshape((ldab, n), order="F"), kl, ku, overwrite_ab=1)
         self.singular = info > 0
+        self._compiled = kl + ku <= COMPILED_SOLVE_MAX
 
     def solve(self, rhs):
+        if self._compiled:
+            x = np.array(rhs, dtype=self.dtype)   # a copy: solved in place
+            _band_solve()(self.lub, self.kl, self.ku, self.piv, x)
+            return x
         x, _ = self._trs(self.lub, self.kl, self.ku, rhs, self.piv)
         return x
 
@@ -136,7 +159,8 @@ class _StageFactors:
     def __init__(self, sm):
         b, h = sm.blocks, sm.h
         K, D, M = b.K, b.D, b.M
-        self.m, self.S, self.Sinv = sm.m, sm.S, sm.Sinv
+        m = sm.m
+        self.m, self.S, self.Sinv = m, sm.S, sm.Sinv
         self.plan = []   # (j, factor or None, conjugate-of index)
         self._complex = {}
         done = {}
@@ -156,9 +180,21 @@ class _StageFactors:
             self.plan.append((j, factorize(csr), None))
             done[j] = lam
         self.singular = any(getattr(f, "singular", False) for _, f, _ in self.plan if f is not None)
+        lu = self.plan[0][1]
+        # Lobatto IIIA-3 and the like: one conjugate pair on a narrow band -> one compiled call per solve
+        self._pair = (m == 2 and self.plan[1][2] == 0 and isinstance(lu, _Banded) and lu._compiled)
+        if self._pair:
+            self._pair_args = (lu.lub, lu.kl, lu.ku, lu.piv, complex(self.S[0, 0]), complex(self.S[1, 0]),
+                               complex(self.Sinv[0, 0]), complex(self.Sinv[0, 1]))
 
     def solve(self, rhs):
         m = self.m
+        if self._pair:
+            R = np.ascontiguousarray(rhs, dtype=float).reshape(-1, 2)
+            out = np.empty(R.shape)
+            lub, kl, ku, piv, s0, s1, w0, w1 = self._pair_args
+            _pair_solve()(lub, kl, ku, piv, R, s0, s1, w0, w1, out)
+            return out.ravel()
         R = np.asarray(rhs).reshape(-1, m)
         RS = R @ self.S                                       # (n, m) complex
         Y = np.empty(RS.shape, dtype=complex)
