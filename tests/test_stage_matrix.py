@@ -52,3 +52,15 @@ def test_stage_matrix_needs_shared_pattern():
     blk = type("B", (), {"K": K, "D": K, "M": K, "same_pattern": False})()
     with pytest.raises(ValueError, match="same_pattern"):
         StageMatrix(blk, 0.1, LOBATTO3)
+
+
+def test_lobatto3_modified_newton_in_eigenbasis_gives_the_full_newton_steps():
+    # Catches: the stage matrix wired with the wrong tableau part or step, which converges
+    # slowly or to nothing; equal steps to the Newton tolerance with the exact per-stage Jacobian.
+    from ancfdae import simulate
+    beam = Beam(BE2D(Material(2.1e10, 0.3, 4000.0), RectangularSection(0.05)), 4, 1.0,
+                supports={0: ("x", "y")}, loads=[Gravity((0.0, -9.81))])
+    runs = [simulate(beam, (0.0, 0.02), "lobatto3", h=1e-3, newton={"tol": 1e-12, "jacobian": j})
+            for j in ("modified", "full")]
+    assert all(r.status == "success" for r in runs)
+    assert np.abs(runs[0].q[-1] - runs[1].q[-1]).max() <= 1e-10 * np.abs(runs[1].q[-1]).max()
