@@ -176,8 +176,7 @@ class _StageFactors:
             else:
                 lr = lam.real
                 data = M.data + (h * lr) * D.data + (h * h * lr * lr) * K.data
-            csr = sp.csr_matrix((data, K.indices, K.indptr), shape=K.shape)
-            self.plan.append((j, factorize(csr), None))
+            self.plan.append((j, _factorize_pattern(data, K.indptr, K.indices, K.shape[0]), None))
             done[j] = lam
         self.singular = any(getattr(f, "singular", False) for _, f, _ in self.plan if f is not None)
         lu = self.plan[0][1]
@@ -233,7 +232,13 @@ def factorize(matrix):
     if matrix.shape[0] != matrix.shape[1]:
         raise ValueError(f"the Jacobian must be a square matrix, got shape {matrix.shape}.")
     csr = matrix if sp.isspmatrix_csr(matrix) else sp.csr_matrix(matrix)
-    band = _band_map(csr.indptr, csr.indices, n)
+    return _factorize_pattern(csr.data, csr.indptr, csr.indices, n)
+
+
+def _factorize_pattern(data, indptr, indices, n):
+    """Factorise the CSR matrix ``(data, indices, indptr)``; the band map is cached by the identity of
+    the pattern arrays, so callers should pass the same arrays every time (the beam's assembler does)."""
+    band = _band_map(indptr, indices, n)
     if n <= SMALL or band[2] <= BAND_FRACTION * n:
-        return _Banded(csr.data, band, n)
-    return _SuperLU(csr)
+        return _Banded(data, band, n)
+    return _SuperLU(sp.csr_matrix((data, indices, indptr), shape=(n, n)))

@@ -422,16 +422,24 @@ class Beam:
             return R
         fn, args = fused
         F = np.empty((m, n + 1))
-        fn(np.ascontiguousarray(Q, dtype=float).ravel(), np.repeat(self._q_fixed, m), gather, idx,
+        q_fixed_m, gravity_m = self._stage_constants(m)
+        fn(np.ascontiguousarray(Q, dtype=float).reshape(-1), q_fixed_m, gather, idx,
            self._asm._slot_all, False, F.reshape(-1), self._no_k, *args)
         if not self._dead and not self._moments:
-            fext = np.broadcast_to(self._f_gravity[:, None], (n, m))
+            fext = gravity_m
         else:
             fext = np.column_stack([self._f_external(ts[i], Q[:, i], False)[0] for i in range(m)])
         R = np.empty((n, m))
         _finish_stages()(F, self._M_data, self._asm.indptr, self._asm.indices, np.ascontiguousarray(A, dtype=float),
                          float(self.load_factor), fext, R)
         return R
+
+    def _stage_constants(self, m):
+        """The fixed coordinates repeated per stage and the gravity force per stage, (n, m) (cached)."""
+        cache = self.__dict__.setdefault("_stage_const", {})
+        if m not in cache:
+            cache[m] = (np.repeat(self._q_fixed, m), np.repeat(self._f_gravity[:, None], m, axis=1))
+        return cache[m]
 
     def _stage_geometry(self, m):
         """Element geometry of ``m`` stacked copies of the mesh and the matching scatter index."""
