@@ -179,6 +179,19 @@ class Element(ABC):
         dfdq : ndarray, shape (n_edof, n_edof), or None
         """
 
+    # -- optional: fused compiled assembly ----------------------------------
+    def fused_kernel(self, geom):
+        """The element's fused gather-kernel-scatter entry point, or None (the default).
+
+        An element with a compiled kernel returns ``(fn, args)``; the beam then
+        assembles the internal forces and tangent by the single call
+        ``fn(q, q_fixed, gather, vec_slot, mat_slot, tangent, r, kdata, *args)``
+        (the contract is in :mod:`ancfdae.models._assembly_numba`), which must
+        give the same arrays as :meth:`internal_forces` followed by the beam's
+        scatter. ``geom`` may be the geometry of stacked copies of the mesh.
+        """
+        return None
+
     # -- optional: configuration-dependent inertia (BE3D) ------------------
     def inertia(self, geom: Any, q: np.ndarray, v: np.ndarray, a: np.ndarray, jacobian: bool = True) -> tuple:
         """Inertia forces beyond the constant mass matrix.

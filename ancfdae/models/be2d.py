@@ -98,7 +98,6 @@ class BE2D(Element):
     def kernel(self, value):
         self._impl = resolve_kernel(value)
         self._kernel = value
-        self._compiled = None
 
     @property
     def kernel_in_use(self) -> str:
@@ -267,20 +266,30 @@ class BE2D(Element):
         K = A @ B + (first @ geom["d2"]).reshape(n_el, 8, 8)
         return f, K
 
-    def _internal_forces_numba(self, geom, q, tangent):
-        """The compiled kernel; imported (and numba with it) on first use."""
-        if self._compiled is None:
-            from . import _be2d_numba as nb
+    def _numba_args(self, geom):
+        """The compiled module and the kernel's arguments after ``q`` (cached in the geometry)."""
+        hit = geom.get("_numba")
+        if hit is None:   # C-contiguous float copies for the compiled loop, once per geometry
+            from . import _be2d_numba as nb   # imports numba: only once the compiled kernel is selected
             form = nb.STRUCTURAL if self.formulation == "structural" else nb.CONTINUUM
             E, sec = self.material.E, self.section
-            self._compiled = (nb.be2d_forces, form, E * sec.A, E, sec.I3, sec.I4)
-        fn, form, EA, E, I, I4 = self._compiled
-        nbg = geom.get("_numba")
-        if nbg is None:   # C-contiguous float copies for the compiled loop, once per geometry
-            nbg = geom["_numba"] = tuple(np.ascontiguousarray(geom[k], dtype=float)
-                                         for k in ("dN_e", "ddN_e", "w", "eps_ref", "K_ref"))
-        f, K = fn(np.ascontiguousarray(q, dtype=float), *nbg, geom["n_a"], form, EA, E, I, I4, bool(tangent))
+            args = tuple(np.ascontiguousarray(geom[k], dtype=float)
+                         for k in ("dN_e", "ddN_e", "w", "eps_ref", "K_ref")) + (
+                geom["n_a"], form, E * sec.A, E, sec.I3, sec.I4)
+            hit = geom["_numba"] = (nb, args, (nb.be2d_fused, args))
+        return hit
+
+    def _internal_forces_numba(self, geom, q, tangent):
+        """The compiled kernel; imported (and numba with it) on first use."""
+        nb, args, _ = self._numba_args(geom)
+        f, K = nb.be2d_forces(np.ascontiguousarray(q, dtype=float), *args, bool(tangent))
         return f, (K if tangent else None)
+
+    def fused_kernel(self, geom):
+        """``(be2d_fused, args)`` with the compiled kernel selected, else None (see :class:`Element`)."""
+        if self._impl != "numba":
+            return None
+        return self._numba_args(geom)[2]
 
     def shape_matrix(self, s, lengths):
         N, _, _ = hermite(np.asarray(s, dtype=float), lengths)

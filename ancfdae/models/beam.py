@@ -9,6 +9,7 @@ its iteration matrix by combining data arrays.
 from __future__ import annotations
 
 import copy
+import functools
 import numbers
 from collections.abc import Iterable, Mapping
 
@@ -25,6 +26,20 @@ from ._mesh import mesh_from_points, straight_mesh
 from ._quadrature import gauss
 
 __all__ = ["Beam"]
+
+
+@functools.cache
+def _finish_residual():
+    """The compiled ``f + M a - lambda f_ext`` (imports numba: only reached on the fused path)."""
+    from ._assembly_numba import finish_residual
+    return finish_residual
+
+
+@functools.cache
+def _finish_stages():
+    """The compiled stage version of :func:`_finish_residual`."""
+    from ._assembly_numba import finish_stages
+    return finish_stages
 
 
 class Beam:
@@ -159,6 +174,27 @@ class Beam:
         self._q_fixed = self.q_ref[fixed].copy()
         self._gather = ext_of_full[self.edofs]
         self._v0 = self._initial_velocity(initial_velocity)
+        self._no_k = np.empty(1)
+        self.assembly = "fused"
+
+    @property
+    def assembly(self) -> str:
+        """Assembly path: "fused" (default) or "numpy".
+
+        ``"fused"``: with an element that offers a compiled kernel
+        (:meth:`ancfdae.models._element.Element.fused_kernel`), gather, kernel
+        and scatter into the fixed CSR data run as one compiled call per
+        evaluation; otherwise (and with ``"numpy"``, the readable reference) the
+        element kernel returns element arrays that ``np.bincount`` sums. Both
+        give the same bits for the same kernel.
+        """
+        return self._assembly
+
+    @assembly.setter
+    def assembly(self, value):
+        if value not in ("fused", "numpy"):
+            raise ValueError(f"`assembly` must be 'fused' or 'numpy', got {value!r}.")
+        self._assembly = value
 
     # -- geometry helpers -------------------------------------------------
     def _node_index(self, node, arg):
@@ -349,24 +385,56 @@ class Beam:
     def _f_external(self, t, q, tangent):
         """``fnc + f_gravity`` (free vector) and the load tangent data (or None); skips the
         non-conservative pass when the beam has no such loads (bit-for-bit: 0 + f_g = f_g)."""
-        if not self._dead and not self._moments:
-            return self._f_gravity, None
+        if not self._moments:
+            if not self._dead:
+                return self._f_gravity, None
+            time, vec = self._dead[0]
+            f = time(t) * vec
+            for time, vec in self._dead[1:]:
+                f += time(t) * vec
+            return f + self._f_gravity, None
         fnc, kload = self._f_nonconservative(t, self.expand(q), tangent)
         return fnc + self._f_gravity, kload
 
+    def _fused(self, geom):
+        """The element's fused entry point ``(fn, args)`` for ``geom``, or None (NumPy assembly)."""
+        return self.element.fused_kernel(geom) if self._assembly == "fused" else None
+
     def internal_forces(self, q, tangent=True):
         """Assembled ``dU/dq`` (free vector) and tangent CSR data (or None)."""
-        fe, ke = self.element.internal_forces(self.geom, self._element_q(q), tangent)
-        return self._asm.vector(fe), (self._asm.data(ke) if tangent else None)
+        return self._assemble(q, tangent)[:2]
+
+    def _assemble(self, q, tangent):
+        """``(f, kdata, fused)``: assembled ``dU/dq``, tangent data or None, and which path ran."""
+        fused = self._fused(self.geom)
+        if fused is None:
+            fe, ke = self.element.internal_forces(self.geom, self._element_q(q), tangent)
+            return self._asm.vector(fe), (self._asm.data(ke) if tangent else None), False
+        fn, args = fused
+        n, nnz = self.n_dof, self._asm.nnz
+        r = np.empty(n + 1)
+        kd = np.empty(nnz + 1) if tangent else self._no_k
+        fn(np.ascontiguousarray(q, dtype=float), self._q_fixed, self._gather, self._asm._vec_all,
+           self._asm._slot_all, bool(tangent), r, kd, *args)
+        return r[:n], (kd[:nnz] if tangent else None), True
+
+    def _static_residual(self, a, f, fext, fused):
+        """``f + M a - lambda f_ext`` (in place in ``f`` on the fused path: the same rounding)."""
+        if fused:
+            _finish_residual()(f, self._M_data, self._asm.indptr, self._asm.indices,
+                            np.ascontiguousarray(a, dtype=float), float(self.load_factor),
+                            np.ascontiguousarray(fext, dtype=float))
+            return f
+        return f + self._M_csr @ a - self.load_factor * fext
 
     def residual(self, t, q, v, a):
         """``r = M(q) a + f_int(q) [+ inertia(q, v, a)] - lambda f_ext(t, q)``."""
         self._check(q, v, a)
-        fe, _ = self.element.internal_forces(self.geom, self._element_q(q), False)
-        r = self._asm.vector(fe) + self._M_csr @ a
+        f, _, fused = self._assemble(q, False)
+        r = self._static_residual(a, f, self._f_external(t, q, False)[0], fused)
         if not self.mass_is_constant:
             r += self._inertia(q, v, a, False)[0]
-        return r - self.load_factor * self._f_external(t, q, False)[0]
+        return r
 
     def residual_stages(self, ts, Q, V, A):
         """Residuals of several stages in one element pass: column ``i`` of the (n_dof, m) result is
@@ -387,18 +455,41 @@ class Beam:
             return np.column_stack([self.residual(ts[i], Q[:, i], V[:, i], A[:, i]) for i in range(m)])
         geom, gather, idx = self._stage_geometry(m)
         n = self.n_dof
-        ext = np.empty((n + self._q_fixed.size, m))   # (free q; fixed values) per stage, stage fastest
-        ext[:n] = Q
-        ext[n:] = self._q_fixed[:, None]
-        fe, _ = self.element.internal_forces(geom, ext.ravel().take(gather), False)
-        F = np.bincount(idx, weights=fe.ravel(), minlength=m * (n + 1)).reshape(m, n + 1)[:, :n].T
-        R = F + self._M_csr @ A
+        fused = self._fused(geom)
+        if fused is None:
+            ext = np.empty((n + self._q_fixed.size, m))   # (free q; fixed values) per stage, stage fastest
+            ext[:n] = Q
+            ext[n:] = self._q_fixed[:, None]
+            fe, _ = self.element.internal_forces(geom, ext.ravel().take(gather), False)
+            F = np.bincount(idx, weights=fe.ravel(), minlength=m * (n + 1))
+            F = F.reshape(m, n + 1)[:, :n].T
+            R = F + self._M_csr @ A
+            if not self._dead and not self._moments:
+                R -= self.load_factor * self._f_gravity[:, None]
+            else:
+                for i in range(m):
+                    R[:, i] -= self.load_factor * self._f_external(ts[i], Q[:, i], False)[0]
+            return R
+        fn, args = fused
+        F = np.empty((m, n + 1))
+        q_fixed_m, gravity_m = self._stage_constants(m)
+        fn(np.ascontiguousarray(Q, dtype=float).reshape(-1), q_fixed_m, gather, idx,
+           self._asm._slot_all, False, F.reshape(-1), self._no_k, *args)
         if not self._dead and not self._moments:
-            R -= self.load_factor * self._f_gravity[:, None]
+            fext = gravity_m
         else:
-            for i in range(m):
-                R[:, i] -= self.load_factor * self._f_external(ts[i], Q[:, i], False)[0]
+            fext = np.column_stack([self._f_external(ts[i], Q[:, i], False)[0] for i in range(m)])
+        R = np.empty((n, m))
+        _finish_stages()(F, self._M_data, self._asm.indptr, self._asm.indices, np.ascontiguousarray(A, dtype=float),
+                         float(self.load_factor), fext, R)
         return R
+
+    def _stage_constants(self, m):
+        """The fixed coordinates repeated per stage and the gravity force per stage, (n, m) (cached)."""
+        cache = self.__dict__.setdefault("_stage_const", {})
+        if m not in cache:
+            cache[m] = (np.repeat(self._q_fixed, m), np.repeat(self._f_gravity[:, None], m, axis=1))
+        return cache[m]
 
     def _stage_geometry(self, m):
         """Element geometry of ``m`` stacked copies of the mesh and the matching scatter index."""
@@ -415,10 +506,9 @@ class Beam:
     def residual_jacobian(self, t, q, v, a):
         """``(residual, jacobian)`` from one kernel pass (the fused path of full Newton)."""
         self._check(q, v, a)
-        fe, ke = self.element.internal_forces(self.geom, self._element_q(q), True)
+        f, K, fused = self._assemble(q, True)
         fext, kload = self._f_external(t, q, True)
-        r = self._asm.vector(fe) + self._M_csr @ a - self.load_factor * fext
-        K = self._asm.data(ke)
+        r = self._static_residual(a, f, fext, fused)
         if kload is not None:
             K -= self.load_factor * kload
         D, M = self._zero_data, self._M_data
@@ -432,8 +522,7 @@ class Beam:
     def jacobian(self, t, q, v, a) -> JacobianBlocks:
         """Exact ``dr/dq``, ``dr/dv``, ``dr/da`` with one shared CSR pattern."""
         self._check(q, v, a)
-        _, ke = self.element.internal_forces(self.geom, self._element_q(q), True)
-        K = self._asm.data(ke)
+        _, K = self.internal_forces(q, True)
         kload = self._f_external(t, q, True)[1] if self._moments else None
         if kload is not None:
             K -= self.load_factor * kload
