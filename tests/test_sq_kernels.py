@@ -90,3 +90,22 @@ def test_kernel_option(steel):
     assert SQ2D(steel, SECTION, kernel="numpy").kernel_in_use == "numpy"
     with pytest.raises(ValueError, match="kernel"):
         SQ3D(steel, SECTION, kernel="fortran")
+
+
+@pytest.mark.parametrize("cls", [SQ2D, SQ3D])
+@pytest.mark.parametrize("nodes", [3, 2])
+def test_numba_moment_load_equals_numpy(steel, cls, nodes):
+    """The compiled dead-moment load (force and derivative) against the NumPy reference, off-node point."""
+    el, beam, qs = _beam_and_states(steel, cls, "structural", nodes)
+    M = np.array([0.3, -0.7, 1.1])
+    for q in qs:
+        for s in (-1.0, 0.37):
+            out = []
+            for kernel in ("numpy", "numba"):
+                el.kernel = kernel
+                f, K = el.moment_load(beam.geom, q[1], s, M, 1)
+                f2, K2 = el.moment_load(beam.geom, q[1], s, M, 1, tangent=False)
+                assert K2 is None and np.array_equal(f, f2)
+                out.append((f, K))
+            (f0, K0), (f1, K1) = out
+            assert rel_err(f1, f0) < 1e-12 and rel_err(K1, K0) < 1e-12

@@ -329,6 +329,11 @@ class SQElement(Element):
         return local_map(N, dN, self.dim)[0, 0, :self.dim * (self.dim - 1)]
 
     def moment_load(self, geom, q, s, moment, element, tangent=True):
+        if self._impl == "numba":
+            from ._sq_numba_moment import sq_moment_load
+            f, K = sq_moment_load(np.ascontiguousarray(q, dtype=float), float(s), self.nodes, self.dim,
+                                  np.ascontiguousarray(moment, dtype=float), bool(tangent))
+            return f, (K if tangent else None)
         Bp = self._slope_map(geom, s, element)
         fp, dfp = self._rotation_force(Bp @ np.asarray(q, dtype=float), np.asarray(moment, dtype=float))
         return Bp.T @ fp, (Bp.T @ dfp @ Bp if tangent else None)

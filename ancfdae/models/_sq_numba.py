@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit
 
 from ._sq_numba_continuum import continuum_point
-from ._sq_numba_structural import N_JETS, structural_point
+from ._sq_numba_structural import N_JETS, needs_frame, structural_point
 
 __all__ = ["sq_structural", "sq_continuum"]
 
@@ -53,36 +53,57 @@ def _gather(qe, Sb, col, dim, v):
 
 
 @njit(**_INLINE)
-def _scatter(g, H, Sb, col, dim, f_row, K_row, order):
-    """``f_row += B^T g`` and, for order 2, ``K_row += B^T H B``."""
-    nb, nn = Sb.shape
-    for b in range(nb):
+def _scatter(g, H, Sb, col, dim, nba, f_row, K_row, order):
+    """``f_row += B^T g`` and, for order 2, ``K_row += B^T H B``, over the first ``nba`` blocks of ``v``.
+
+    ``g`` and ``H`` must vanish outside those blocks (a point with cross-section terms only touches
+    the slopes ``a_k``). ``B^T H B`` is symmetric: each pair of (block, node) entries of ``B`` is
+    visited once and its 3 x 3 product added at both places; zero shape-function values are skipped
+    (the end-point rule has ``N = delta``).
+    """
+    nn = Sb.shape[1]
+    for b in range(nba):
         for i in range(nn):
             for c in range(dim):
                 f_row[col[b, i] + c] += Sb[b, i] * g[b * dim + c]
     if order < 2:
         return
-    for b in range(nb):
-        for i in range(nn):
-            r0, si = col[b, i], Sb[b, i]
-            for b2 in range(nb):
-                for j in range(nn):
-                    c0, s = col[b2, j], si * Sb[b2, j]
-                    for c in range(dim):
-                        for c2 in range(dim):
-                            K_row[r0 + c, c0 + c2] += s * H[b * dim + c, b2 * dim + c2]
+    for u in range(nba * nn):
+        b, i = u // nn, u % nn
+        si = Sb[b, i]
+        if si == 0.0:
+            continue
+        r0 = col[b, i]
+        for u2 in range(u, nba * nn):
+            b2, j = u2 // nn, u2 % nn
+            s = si * Sb[b2, j]
+            if s == 0.0:
+                continue
+            c0 = col[b2, j]
+            if u2 == u:
+                for c in range(dim):
+                    for c2 in range(dim):
+                        K_row[r0 + c, c0 + c2] += s * H[b * dim + c, b2 * dim + c2]
+            else:
+                for c in range(dim):
+                    for c2 in range(dim):
+                        x = s * H[b * dim + c, b2 * dim + c2]
+                        K_row[r0 + c, c0 + c2] += x
+                        K_row[c0 + c2, r0 + c] += x
 
 
 @njit(**_INLINE)
 def _structural_element(dim, qe, N, dN, Dw, ref, f_row, K_row, order, Sb, col, v, g, H, JV, JG, JH, eps, sig, Jm):
     """Energy of one element; its force and tangent added into ``f_row`` and ``K_row``."""
     W = 0.0
+    nb = 2 * dim - 1
     for p in range(N.shape[0]):
         _shape_table(N[p], dN[p], dim, Sb, col)
         _gather(qe, Sb, col, dim, v)
         W += structural_point(dim, v, Dw[p], ref[p], JV, JG, JH, eps, sig, Jm, g, H, order)
         if order >= 1:
-            _scatter(g, H, Sb, col, dim, f_row, K_row, order)
+            # without the frame terms only the slopes a_k (the first dim - 1 blocks) carry energy
+            _scatter(g, H, Sb, col, dim, nb if needs_frame(dim, Dw[p]) else dim - 1, f_row, K_row, order)
     return W
 
 
@@ -128,7 +149,7 @@ def _continuum_element(dim, qe, N, dN, wax, blk, coef, cnt, ws, Ds, ref, vi, vj,
         W += continuum_point(dim, v, blk, coef, cnt, ws, Ds, ref[p], wax[p], vi, vj, X, eps, sig, S, Bm, DB, HX,
                              g, H, order)
         if order >= 1:
-            _scatter(g, H, Sb, col, dim, f_row, K_row, order)
+            _scatter(g, H, Sb, col, dim, 2 * dim - 1, f_row, K_row, order)
     return W
 
 

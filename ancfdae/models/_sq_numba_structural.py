@@ -18,7 +18,8 @@ from numba import njit
 
 from ._jet_numba import jcross, jdot, jmul, jrecip, jsqrt, jturn, jvar
 
-__all__ = ["N_JETS", "TERMS_2D", "SQUARES_2D", "TERMS_3D", "SQUARES_3D", "structural_point"]
+__all__ = ["frame2d", "frame3d", "needs_frame", "N_JETS", "TERMS_2D", "SQUARES_2D", "TERMS_3D", "SQUARES_3D",
+           "structural_point"]
 
 _OPTS = dict(cache=True, fastmath={"contract"})
 
@@ -39,50 +40,59 @@ SQUARES_2D = np.array([[3, 1, 1]], dtype=np.int64)
 
 
 @njit(**_OPTS)
-def _frame3d(JV, JG, JH, order, need_frame):
+def frame3d(JV, JG, JH, order, need_frame):
     """Jets of the frame of chapter Eq. 7 and the curvature coefficients (rows of TERMS_3D).
 
     Rows: 0 a2, 1 a3, 2 m2 = a3.a3, 3 m, 4 1/m, 5 e3, 6 a2 x a3, 7 n2, 8 n, 9 1/n, 10 e1,
     11 e2, 12 t = a2.e3, 13 -e2/m, 14 e1/m, 15 m/n, 16 -(m/n) e1, 17 t/n, 18 (t/n) e1,
     19 a2.a2, 21 a2.a3.
     """
-    jdot(3, JV[1], JG[1], JH[1], JV[1], JG[1], JH[1], JV[2], JG[2], JH[2], order)
-    jdot(3, JV[0], JG[0], JH[0], JV[0], JG[0], JH[0], JV[19], JG[19], JH[19], order)
-    jdot(3, JV[0], JG[0], JH[0], JV[1], JG[1], JH[1], JV[21], JG[21], JH[21], order)
+    jdot(3, JV, JG, JH, 1, 1, 2, order)
+    jdot(3, JV, JG, JH, 0, 0, 19, order)
+    jdot(3, JV, JG, JH, 0, 1, 21, order)
     if not need_frame:
         return
-    jsqrt(JV[2], JG[2], JH[2], JV[3], JG[3], JH[3], order)
-    jrecip(JV[3], JG[3], JH[3], JV[4], JG[4], JH[4], order)
-    jmul(1.0, 3, JV[4], JG[4], JH[4], JV[1], JG[1], JH[1], JV[5], JG[5], JH[5], order)
-    jcross(JV[0], JG[0], JH[0], JV[1], JG[1], JH[1], JV[6], JG[6], JH[6], order)
-    jdot(3, JV[6], JG[6], JH[6], JV[6], JG[6], JH[6], JV[7], JG[7], JH[7], order)
-    jsqrt(JV[7], JG[7], JH[7], JV[8], JG[8], JH[8], order)
-    jrecip(JV[8], JG[8], JH[8], JV[9], JG[9], JH[9], order)
-    jmul(1.0, 3, JV[9], JG[9], JH[9], JV[6], JG[6], JH[6], JV[10], JG[10], JH[10], order)
-    jcross(JV[5], JG[5], JH[5], JV[10], JG[10], JH[10], JV[11], JG[11], JH[11], order)
-    jdot(3, JV[0], JG[0], JH[0], JV[5], JG[5], JH[5], JV[12], JG[12], JH[12], order)
-    jmul(-1.0, 3, JV[4], JG[4], JH[4], JV[11], JG[11], JH[11], JV[13], JG[13], JH[13], order)
-    jmul(1.0, 3, JV[4], JG[4], JH[4], JV[10], JG[10], JH[10], JV[14], JG[14], JH[14], order)
-    jmul(1.0, 1, JV[3], JG[3], JH[3], JV[9], JG[9], JH[9], JV[15], JG[15], JH[15], order)
-    jmul(-1.0, 3, JV[15], JG[15], JH[15], JV[10], JG[10], JH[10], JV[16], JG[16], JH[16], order)
-    jmul(1.0, 1, JV[12], JG[12], JH[12], JV[9], JG[9], JH[9], JV[17], JG[17], JH[17], order)
-    jmul(1.0, 3, JV[17], JG[17], JH[17], JV[10], JG[10], JH[10], JV[18], JG[18], JH[18], order)
+    jsqrt(JV, JG, JH, 2, 3, order)
+    jrecip(JV, JG, JH, 3, 4, order)
+    jmul(1.0, 3, JV, JG, JH, 4, 1, 5, order)
+    jcross(JV, JG, JH, 0, 1, 6, order)
+    jdot(3, JV, JG, JH, 6, 6, 7, order)
+    jsqrt(JV, JG, JH, 7, 8, order)
+    jrecip(JV, JG, JH, 8, 9, order)
+    jmul(1.0, 3, JV, JG, JH, 9, 6, 10, order)
+    jcross(JV, JG, JH, 5, 10, 11, order)
+    jdot(3, JV, JG, JH, 0, 5, 12, order)
+    jmul(-1.0, 3, JV, JG, JH, 4, 11, 13, order)
+    jmul(1.0, 3, JV, JG, JH, 4, 10, 14, order)
+    jmul(1.0, 1, JV, JG, JH, 3, 9, 15, order)
+    jmul(-1.0, 3, JV, JG, JH, 15, 10, 16, order)
+    jmul(1.0, 1, JV, JG, JH, 12, 9, 17, order)
+    jmul(1.0, 3, JV, JG, JH, 17, 10, 18, order)
 
 
 @njit(**_OPTS)
-def _frame2d(JV, JG, JH, order, need_frame):
+def frame2d(JV, JG, JH, order, need_frame):
     """Jets of the planar frame: rows 0 a, 1 a.a, 2 |a|, 3 1/|a|, 4 e2, 5 turn(e2), 6 1/a.a,
     7 (-a_y, a_x), 8 (-a_y, a_x)/a.a."""
-    jdot(2, JV[0], JG[0], JH[0], JV[0], JG[0], JH[0], JV[1], JG[1], JH[1], order)
+    jdot(2, JV, JG, JH, 0, 0, 1, order)
     if not need_frame:
         return
-    jsqrt(JV[1], JG[1], JH[1], JV[2], JG[2], JH[2], order)
-    jrecip(JV[2], JG[2], JH[2], JV[3], JG[3], JH[3], order)
-    jmul(1.0, 2, JV[3], JG[3], JH[3], JV[0], JG[0], JH[0], JV[4], JG[4], JH[4], order)
-    jturn(1.0, JV[4], JG[4], JH[4], JV[5], JG[5], JH[5], order)
-    jrecip(JV[1], JG[1], JH[1], JV[6], JG[6], JH[6], order)
-    jturn(-1.0, JV[0], JG[0], JH[0], JV[7], JG[7], JH[7], order)
-    jmul(1.0, 2, JV[6], JG[6], JH[6], JV[7], JG[7], JH[7], JV[8], JG[8], JH[8], order)
+    jsqrt(JV, JG, JH, 1, 2, order)
+    jrecip(JV, JG, JH, 2, 3, order)
+    jmul(1.0, 2, JV, JG, JH, 3, 0, 4, order)
+    jturn(1.0, JV, JG, JH, 4, 5, order)
+    jrecip(JV, JG, JH, 1, 6, order)
+    jturn(-1.0, JV, JG, JH, 0, 7, order)
+    jmul(1.0, 2, JV, JG, JH, 6, 7, 8, order)
+
+
+@njit(**_OPTS)
+def needs_frame(dim, Dw):
+    """Whether a point carries any strain of the frame (all but the cross-section strains E_kl)."""
+    for k in range(Dw.shape[0] - (3 if dim == 3 else 1)):
+        if Dw[k] != 0.0:
+            return True
+    return False
 
 
 @njit(**_OPTS)
@@ -101,18 +111,15 @@ def structural_point(dim, v, Dw, ref, JV, JG, JH, eps, sig, Jm, g, H, order):
     npv = dim * (dim - 1)
     nv = v.shape[0]
     nk = Dw.shape[0]
-    need_frame = False
-    for k in range(nk - (3 if dim == 3 else 1)):
-        if Dw[k] != 0.0:
-            need_frame = True
+    need_frame = needs_frame(dim, Dw)
     if dim == 3:
-        jvar(v[0:3], 0, JV[0], JG[0], JH[0], order)
-        jvar(v[3:6], 3, JV[1], JG[1], JH[1], order)
-        _frame3d(JV, JG, JH, order, need_frame)
+        jvar(v, 0, 3, 0, JV, JG, JH, 0, order)
+        jvar(v, 3, 3, 3, JV, JG, JH, 1, order)
+        frame3d(JV, JG, JH, order, need_frame)
         terms, squares = TERMS_3D, SQUARES_3D
     else:
-        jvar(v[0:2], 0, JV[0], JG[0], JH[0], order)
-        _frame2d(JV, JG, JH, order, need_frame)
+        jvar(v, 0, 2, 0, JV, JG, JH, 0, order)
+        frame2d(JV, JG, JH, order, need_frame)
         terms, squares = TERMS_2D, SQUARES_2D
     nt = terms.shape[0] if need_frame else 0
     for k in range(nk):
