@@ -70,19 +70,40 @@ class Material:
         return self.E / (2.0 * (1.0 + self.nu))
 
 
+def _check_factors(section) -> None:
+    """Validate ``shear_factor``, ``torsion_factor`` and ``shear_factors`` of a section (frozen dataclass)."""
+    for name in ("shear_factor", "torsion_factor"):   # stored as floats (numpy scalars are numbers)
+        value = getattr(section, name)
+        if value is not None:
+            object.__setattr__(section, name, positive(name, value))
+    pair = section.shear_factors
+    if pair is None:
+        return
+    if section.shear_factor is not None:
+        raise ValueError("give either `shear_factor` (k2 = k3) or `shear_factors` (k2, k3), not both; got "
+                         f"shear_factor={section.shear_factor!r}, shear_factors={pair!r}.")
+    if isinstance(pair, (str, bytes)) or not hasattr(pair, "__len__") or len(pair) != 2:
+        raise ValueError(f"`shear_factors` must be a pair (k2, k3) of positive numbers, got {pair!r}.")
+    object.__setattr__(section, "shear_factors",
+                       (positive("shear_factors[0]", pair[0]), positive("shear_factors[1]", pair[1])))
+
+
+def _common_shear_factor(section, default: float) -> float:
+    """``k_s`` when k2 = k3; a clear error when the section has two different factors."""
+    if section.shear_factors is not None:
+        k2, k3 = section.shear_factors
+        if k2 != k3:
+            raise ValueError(f"this section has two shear factors, shear_factors={section.shear_factors!r}; "
+                             "use `shear_factors_of(material)` instead of `k_s`.")
+        return k2
+    return section.shear_factor if section.shear_factor is not None else default
+
+
 def _saint_venant_rectangle(h: float, b: float, terms: int = 50) -> float:
     """Saint-Venant torsion constant of an h x b rectangle (series solution)."""
     long, short = max(h, b), min(h, b)
     s = sum(math.tanh(n * math.pi * long / (2 * short)) / n**5 for n in range(1, 2 * terms, 2))
     return long * short**3 / 3.0 * (1.0 - 192.0 / math.pi**5 * short / long * s)
-
-
-def _optional_factors(section):
-    """Check the optional ``shear_factor`` and ``torsion_factor`` and store them as floats."""
-    for name in ("shear_factor", "torsion_factor"):
-        value = getattr(section, name)
-        if value is not None:
-            object.__setattr__(section, name, positive(name, value))
 
 
 @dataclass(frozen=True)
@@ -94,24 +115,33 @@ class RectangularSection:
     h, b : float
         Side lengths (> 0); ``b`` defaults to ``h`` (square).
     shear_factor : float, optional
-        Shear correction factor ``k_s`` used for ``k2`` and ``k3``; None
-        selects Cowper's value of chapter Eq. 112 for the material's ``nu``.
+        One shear correction factor ``k_s`` for both transverse shears
+        (``k2 = k3 = k_s``); None selects Cowper's value of chapter Eq. 112 for
+        the material's ``nu``.
     torsion_factor : float, optional
         ``k_t`` such that the torsional rigidity is ``G J k_t`` with
-        ``J = I2 + I3``; None selects the Saint-Venant value (0.8436 for a square).
+        ``J = I2 + I3``; None selects the Saint-Venant value (0.8436 for a
+        square). Nachbagauer et al. (2013) call it ``k1`` (0.5768 for their
+        0.2 x 0.4 section).
+    shear_factors : (float, float), optional
+        ``(k2, k3)``: separate factors for the shear along ``eta`` (``Gamma_2``,
+        stiffness ``k2 G A``) and along ``zeta`` (``Gamma_3``, ``k3 G A``),
+        chapter Eq. 42; e.g. ``(0.8331, 0.7961)`` in Nachbagauer et al. (2013).
+        Not together with ``shear_factor``. The planar elements use ``k2``.
     """
 
     h: float
     b: float | None = None
     shear_factor: float | None = None
     torsion_factor: float | None = None
+    shear_factors: tuple | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "h", positive("h", self.h))
         if self.b is None:
             object.__setattr__(self, "b", self.h)
         object.__setattr__(self, "b", positive("b", self.b))
-        _optional_factors(self)
+        _check_factors(self)
 
     @property
     def A(self) -> float:
@@ -139,8 +169,15 @@ class RectangularSection:
         return self.I2 + self.I3
 
     def k_s(self, material: Material) -> float:
-        """Shear correction factor (Cowper's by default)."""
-        return self.shear_factor if self.shear_factor is not None else cowper_shear_factor(material.nu)
+        """The common shear correction factor (Cowper's by default); see :meth:`shear_factors_of`."""
+        return _common_shear_factor(self, cowper_shear_factor(material.nu))
+
+    def shear_factors_of(self, material: Material) -> tuple[float, float]:
+        """``(k2, k3)``: the shear factors along ``eta`` and ``zeta`` (chapter Eq. 42)."""
+        if self.shear_factors is not None:
+            return self.shear_factors
+        k = self.k_s(material)
+        return k, k
 
     @property
     def k_t(self) -> float:
@@ -162,18 +199,22 @@ class CircularSection:
     d : float
         Diameter (> 0).
     shear_factor : float, optional
-        Shear correction factor ``k_s``; None selects Cowper's.
+        Shear correction factor ``k_s`` (k2 = k3); None selects Cowper's.
     torsion_factor : float, optional
         ``k_t``; None selects 1.
+    shear_factors : (float, float), optional
+        ``(k2, k3)`` along ``eta`` and ``zeta`` instead of one ``shear_factor``
+        (as for :class:`RectangularSection`).
     """
 
     d: float
     shear_factor: float | None = None
     torsion_factor: float | None = None
+    shear_factors: tuple | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "d", positive("d", self.d))
-        _optional_factors(self)
+        _check_factors(self)
 
     @property
     def A(self) -> float:
@@ -201,7 +242,7 @@ class CircularSection:
         return self.I2 + self.I3
 
     def k_s(self, material: Material) -> float:
-        """Shear correction factor (Cowper's solid circle by default).
+        """The common shear correction factor (Cowper's for a solid circle by default).
 
         Parameters
         ----------
@@ -212,9 +253,14 @@ class CircularSection:
         -------
         float
         """
-        if self.shear_factor is not None:
-            return self.shear_factor
-        return 6.0 * (1.0 + material.nu) / (7.0 + 6.0 * material.nu)
+        return _common_shear_factor(self, 6.0 * (1.0 + material.nu) / (7.0 + 6.0 * material.nu))
+
+    def shear_factors_of(self, material: Material) -> tuple[float, float]:
+        """``(k2, k3)``: the shear factors along ``eta`` and ``zeta`` (chapter Eq. 42)."""
+        if self.shear_factors is not None:
+            return self.shear_factors
+        k = self.k_s(material)
+        return k, k
 
     @property
     def k_t(self) -> float:
