@@ -325,11 +325,12 @@ class Beam:
         """Shape checks of the contract's arguments: a wrong length would otherwise assemble silently
         into a wrong-sized residual or fail deep inside numpy."""
         n = (self.n_dof,)
-        if np.shape(q) != n:
+        # Attribute access for arrays (tens of ns); anything else goes through np.shape in check_shape.
+        if getattr(q, "shape", None) != n:
             check_shape("q", q, n, f"n_dof = {self.n_dof}")
-        if v is not None and np.shape(v) != n:
+        if v is not None and getattr(v, "shape", None) != n:
             check_shape("v", v, n, f"n_dof = {self.n_dof}")
-        if a is not None and np.shape(a) != n:
+        if a is not None and getattr(a, "shape", None) != n:
             check_shape("a", a, n, f"n_dof = {self.n_dof}")
 
     def initial_state(self):
