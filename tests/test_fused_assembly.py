@@ -70,3 +70,27 @@ def test_fused_path_is_taken_and_numpy_kernel_has_none():
 def test_bad_assembly_option():
     with pytest.raises(ValueError, match="assembly"):
         _beam("structural").assembly = "cuda"
+
+
+@pytest.mark.parametrize("name", ["SQ2D", "SQ3D"])
+@pytest.mark.parametrize("formulation", ["structural", "continuum"])
+def test_sq_fused_equals_numpy_assembly(name, formulation):
+    # Same defects as above, for the SQ kernels' fused entry points (9 coordinates per node in 3D).
+    from ancfdae import models
+    el = getattr(models, name)(Material(2.1e11, 0.3, 7800.0), RectangularSection(0.1), formulation=formulation,
+                               kernel="numba")
+    dim = el.dim
+    beam = Beam(el, 3, 2.0, supports={0: "clamp"},
+                loads=[PointForce(np.r_[1e5, 2e5, np.zeros(dim - 2)], s=1.3), Gravity(np.r_[0.0, -9.81, np.zeros(dim - 2)])])
+    assert el.fused_kernel(beam.geom) is not None
+    rng = np.random.default_rng(7)
+    n = beam.n_dof
+    q = beam.initial_state()[0] + 0.01 * rng.standard_normal(n)
+    a = rng.standard_normal(n)
+    (f1, k1), (f0, k0) = _both(beam, lambda: beam.internal_forces(q, True))
+    assert np.array_equal(f1, f0) and np.array_equal(k1, k0) and np.abs(f0).max() > 0
+    (r1, J1), (r0, J0) = _both(beam, lambda: beam.residual_jacobian(0.2, q, a, a))
+    assert np.array_equal(r1, r0) and np.array_equal(J1.K.toarray(), J0.K.toarray())
+    Q = q[:, None] + 0.01 * rng.standard_normal((n, 2))
+    R1, R0 = _both(beam, lambda: beam.residual_stages(np.array([0.1, 0.3]), Q, Q, Q))
+    assert np.array_equal(R1, R0)

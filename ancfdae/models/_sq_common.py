@@ -297,6 +297,20 @@ class SQElement(Element):
             return _sq_numba.sq_structural(q, *nbg, self.dim, order)
         return _sq_numba.sq_continuum(q, *nbg, self.dim, order)
 
+    def fused_kernel(self, geom):
+        """The fused compiled entry point ``(fn, args)`` with the compiled kernel selected, else None."""
+        if self._impl != "numba":
+            return None
+        hit = geom.get("_numba_fused")
+        if hit is None:
+            from . import _sq_fused_numba as fz
+            nbg = geom.get("_numba")
+            if nbg is None:
+                nbg = geom["_numba"] = _numba_geometry(self.formulation, self.dim, self._stiffness_count(), geom)
+            fn = fz.sq_structural_fused if self.formulation == "structural" else fz.sq_continuum_fused
+            hit = geom["_numba_fused"] = (fn, tuple(nbg) + (self.dim,))
+        return hit
+
     def _stiffness_count(self) -> int:
         return len(self._terms)
 
