@@ -81,7 +81,8 @@ def main(argv=None):
     if not args.skip_dynamic:
         r = dynamic_case(8, 1.0, 1e-3, args.dyn_repeats)
         print(f"B3 rev. 2, BE3D 8 el, lobatto3, h = 1e-3, 1 s: median wall of {args.dyn_repeats} runs: "
-              f"numpy {r['numpy']:.2f} s (CPU {r['cpu numpy']:.2f} s), numba {r['numba']:.2f} s (CPU {r['cpu numba']:.2f} s), "
+              f"numpy {r['numpy']:.2f} s (CPU {r['cpu numpy']:.2f} s), "
+              f"numba {r['numba']:.2f} s (CPU {r['cpu numba']:.2f} s), "
               f"ratio wall {r['numba'] / r['numpy']:.3f}, CPU {r['cpu numba'] / r['cpu numpy']:.3f}, "
               f"|tip diff| {r['tip_diff']:.2e}; stats {r['stats']}")
 
