@@ -50,9 +50,9 @@ class Result:
     options : dict
         The integrator's options (JSON-able), for the record.
     model_state : dict
-        ``{name: ndarray of shape (n_out, ...)}``: model state beyond ``q``
-        that the outputs need, e.g. the BE3D nodal ``"directors"``
-        ``(n_out, n_nodes, 3)``.
+        The model's event state at ``t`` (models with the ``"step_events"`` capability):
+        ``{name: ndarray of shape (n_out, ...)}``, e.g. BE3D's ``"directors"``, shape
+        ``(n_out, n_nodes, 3)``. Empty for models without event state.
     model : dict
         JSON-able description of the model (``model.describe()`` when it has
         one, plus ``"dof_labels"``: ``{"node": [...], "coordinate": [...]}``);
@@ -85,12 +85,14 @@ class Result:
             if arr.ndim != 2 or arr.shape[0] != n:
                 raise ValueError(f"`{name}` must have shape ({n}, n_dof) to match `t`, got {arr.shape}.")
             setattr(self, name, arr)
-        for key, arr in self.model_state.items():
-            arr = np.asarray(arr)
-            if arr.ndim == 0 or arr.shape[0] != n:
+        state = {}
+        for key, arr in dict(self.model_state or {}).items():
+            arr = np.asarray(arr, dtype=float)
+            if arr.ndim < 1 or arr.shape[0] != n:
                 raise ValueError(f"`model_state[{key!r}]` must have {n} rows (one per output time), "
                                  f"got shape {arr.shape}.")
-            self.model_state[key] = arr
+            state[str(key)] = arr
+        self.model_state = state
 
     @property
     def success(self) -> bool:

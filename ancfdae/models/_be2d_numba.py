@@ -1,4 +1,4 @@
-"""Compiled BE2D kernel (optional, needs numba: ``pip install "ancfdae[fast]"``).
+"""Compiled BE2D kernel (the default of :class:`ancfdae.models.BE2D`, ``kernel="auto"``).
 
 The same force and exact tangent as the NumPy kernel of :class:`ancfdae.models.BE2D`
 (chapter Eqs. 70, 78, 82-88, written in the invariants ``g = r'.r'`` and

@@ -14,34 +14,16 @@ exact, for all elements and points in a few ``einsum`` calls.
 """
 from __future__ import annotations
 
-import importlib.util
-
 import numpy as np
 
 from .._validate import choice, positive_int
 from ..materials import Material
 from ._element import Element
+from ._kernel_option import resolve_kernel
 from ._quadrature import gauss
 from ._shapes import hermite
 
 __all__ = ["BE2D"]
-
-KERNELS = ("auto", "numpy", "numba")
-
-
-def _numba_available() -> bool:
-    return importlib.util.find_spec("numba") is not None
-
-
-def _resolve_kernel(kernel: str) -> str:
-    """The implementation behind a ``kernel`` option: "numpy" or "numba"."""
-    kernel = choice("kernel", kernel, KERNELS)
-    if kernel == "auto":
-        return "numba" if _numba_available() else "numpy"
-    if kernel == "numba" and not _numba_available():
-        raise ImportError("`kernel` 'numba' needs numba, which is not installed; install it with "
-                          "`pip install \"ancfdae[fast]\"` or use kernel='auto' or 'numpy'.")
-    return kernel
 
 # (r' x r'').e_z = r'^T P r''
 _P = np.array([[0.0, 1.0], [-1.0, 0.0]])
@@ -82,10 +64,9 @@ class BE2D(Element):
         Implementation of :meth:`internal_forces`. ``"numpy"``: vectorised
         NumPy, the reference. ``"numba"``: one compiled loop over elements x
         points (:mod:`ancfdae.models._be2d_numba`, same results to rounding;
-        needs the optional dependency numba, ``pip install "ancfdae[fast]"``;
         the first call compiles, or loads the on-disk cache). ``"auto"``
-        (default): numba when importable, else NumPy. Settable later through
-        the ``kernel`` attribute.
+        (default): numba (a dependency of ancfdae) when importable, else
+        NumPy. Settable later through the ``kernel`` attribute.
     """
 
     name = "BE2D"
@@ -115,7 +96,7 @@ class BE2D(Element):
 
     @kernel.setter
     def kernel(self, value):
-        self._impl = _resolve_kernel(value)
+        self._impl = resolve_kernel(value)
         self._kernel = value
         self._compiled = None
 
