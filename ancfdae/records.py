@@ -100,6 +100,10 @@ def _set(tree: dict, dotted: str, value: Any) -> None:
 def load_records(path: str | os.PathLike) -> list[dict]:
     """Read the records written by :func:`save_records`.
 
+    Parameters
+    ----------
+    path : str or path-like
+
     Returns
     -------
     list of dict
