@@ -62,9 +62,12 @@ def _jsonable(obj):
     return obj
 
 
-def _dump(obj) -> str:
+def _dump(obj, what: str = "value") -> str:
     # allow_nan keeps NaN/inf statistics (e.g. a drift of an empty run); json reads them back.
-    return json.dumps(_jsonable(obj), allow_nan=True)
+    try:
+        return json.dumps(_jsonable(obj), allow_nan=True)
+    except TypeError as exc:
+        raise ValueError(f"Result.{what} must be JSON-able to be saved: {exc}.") from None
 
 
 def describe_model(model) -> dict:
@@ -139,8 +142,8 @@ def to_dataset(result):
     attrs = {
         "format": FORMAT, "status": result.status, "message": result.message, "method": result.method,
         "t_fail": math.nan if result.t_fail is None else float(result.t_fail),
-        "stats": _dump(result.stats), "options": _dump(result.options),
-        "monitor_scalars": _dump(scalars), "model": _dump(model), "unit_system": _UNITS,
+        "stats": _dump(result.stats, "stats"), "options": _dump(result.options, "options"),
+        "monitor_scalars": _dump(scalars, "monitors"), "model": _dump(model, "model"), "unit_system": _UNITS,
     }
     for key in ("formulation",):
         if key in model:

@@ -125,6 +125,19 @@ def test_time_major_shapes_and_validation():
     assert not empty.success and "[]" in repr(empty)
 
 
+def test_save_names_what_is_not_json_able(tmp_path):
+    r = Result(t=[0.0], q=np.zeros((1, 2)), v=np.zeros((1, 2)), a=np.zeros((1, 2)), options={"f": object()})
+    with pytest.raises(ValueError, match="Result.options must be JSON-able"):
+        r.save(tmp_path / "x.nc")
+
+
+def test_empty_failed_result_round_trip(tmp_path):
+    empty = Result(t=[], q=np.zeros((0, 4)), v=np.zeros((0, 4)), a=np.zeros((0, 4)), status="failed",
+                   message="failed at once", t_fail=0.0)
+    back = Result.load(empty.save(tmp_path / "empty.nc"))
+    _assert_same(back, empty)
+
+
 @pytest.fixture
 def saved(tmp_path):
     res = simulate(SpringChain(2), (0, 0.1), "lobatto3", h=0.01, monitors=[EnergyMonitor()])
