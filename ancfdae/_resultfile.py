@@ -12,7 +12,8 @@ coordinates ``time``, ``node`` (node index of each coordinate) and
 ``status``, ``message``, ``method``, ``t_fail``, the JSON texts ``stats``,
 ``options``, ``monitor_scalars`` and ``model`` (the beam description), and
 readable copies ``element``, ``formulation``, ``material``, ``section``,
-``loads``, ``unit_system``.
+``loads``, ``unit_system``; the mesh also as the variables ``reference_nodes``
+``(mesh_node, space)`` and ``element_nodes`` ``(element, element_node)``.
 
 Engine
 ------
@@ -151,6 +152,11 @@ def to_dataset(result):
     for key in ("element", "material", "section", "loads"):
         if key in model:
             attrs[key] = _dump(model[key])
+    if "nodes" in model:    # the mesh as arrays too, for readers that do not parse the JSON description
+        data["reference_nodes"] = (("mesh_node", "space"), np.asarray(model["nodes"], dtype=float),
+                                   {"long_name": "reference positions of the nodes (the dof coordinate 'node')"})
+        data["element_nodes"] = (("element", "element_node"), np.asarray(model["element_nodes"], dtype=np.int64),
+                                 {"long_name": "nodes of each element (3-node elements: start, end, middle)"})
     ds = xr.Dataset(data, coords={"time": ("time", result.t), "node": ("dof", node),
                                   "coordinate": ("dof", coord)}, attrs=attrs)
     ds["time"].attrs["long_name"] = "output time"

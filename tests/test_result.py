@@ -77,6 +77,8 @@ def test_round_trip_every_element_with_model_description(tmp_path, element_cls, 
         assert list(ds["coordinate"].values) == list(coord)
         assert ds["q"].dims == ("time", "dof") and ds["monitor.energy.total"].dims == ("time",)
         assert json.loads(ds.attrs["element"])["type"] == element_cls.name
+        np.testing.assert_array_equal(ds["reference_nodes"].values, beam.points)
+        np.testing.assert_array_equal(ds["element_nodes"].values, beam.element_nodes)
         assert ds.attrs["formulation"] == options.get("formulation", "structural")
         if element_cls is BE3D:
             assert ds["state.directors"].shape == (res.t.size, beam.n_nodes, 3)
