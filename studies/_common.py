@@ -164,11 +164,11 @@ class Sweep:
         return [r for r in self.records if r is not None]
 
 
-def progress_bar(name: str, total: int, initial: int = 0, enabled: bool = True):
-    """A tqdm bar on stderr: cases done, elapsed time, estimated time left, last case finished."""
+def progress_bar(name: str, total: float, initial: float = 0, enabled: bool = True):
+    """A tqdm bar on stderr: share of the work done, elapsed time, estimated time left, cases done and the last."""
     from tqdm import tqdm
-    return tqdm(total=total, initial=initial, desc=name, unit="case", file=sys.stderr, disable=not enabled,
-                dynamic_ncols=True, bar_format="{desc} {n_fmt}/{total_fmt} [{elapsed}<{remaining}] {postfix}")
+    return tqdm(total=total, initial=initial, desc=name, file=sys.stderr, disable=not enabled, dynamic_ncols=True,
+                bar_format="{desc} {percentage:3.0f}% [{elapsed}<{remaining}] {postfix}")
 
 
 def _ignore_sigint():
@@ -193,7 +193,7 @@ def _error_text(exc: BaseException) -> str:
 
 
 def run_cases(fn, cases, out=None, executor: Executor | None = None, jobs: int | None = None, reduce=None,
-              name: str = "study", progress: bool = True) -> Sweep:
+              name: str = "study", progress: bool = True, cost=None) -> Sweep:
     """Run ``fn`` over ``cases``, keeping each finished case in ``out``.
 
     Parameters
@@ -224,6 +224,10 @@ def run_cases(fn, cases, out=None, executor: Executor | None = None, jobs: int |
     progress : bool
         Show a progress bar with elapsed time and the estimated time left,
         advancing in completion order.
+    cost : callable, optional
+        Relative cost of a case (``cost(case) -> float``); the progress bar
+        advances by it, so that its estimate of the time left holds when the
+        cases differ in cost (default: equal).
 
     Returns
     -------
@@ -253,7 +257,9 @@ def run_cases(fn, cases, out=None, executor: Executor | None = None, jobs: int |
     if sweep.reused and progress:
         print(f"{name}: reusing {sweep.reused} of {len(cases)} finished cases from {store.folder}",
               file=sys.stderr, flush=True)
-    bar = progress_bar(name, len(cases), sweep.reused, progress)
+    weight = [float(cost(c)) if cost is not None else 1.0 for c in cases]
+    bar = progress_bar(name, sum(weight), sum(w for w, r in zip(weight, records) if r is not None), progress)
+    count = [sweep.reused]
 
     def finish(i, record=None, exc=None):
         if exc is not None:
@@ -266,8 +272,9 @@ def run_cases(fn, cases, out=None, executor: Executor | None = None, jobs: int |
             if store is not None:
                 store.save(cases[i], record)
             records[i] = reduce(record)
-        bar.set_postfix_str(labels[i], refresh=False)
-        bar.update()
+        count[0] += 1
+        bar.set_postfix_str(f"{count[0]}/{len(cases)} cases, last: {labels[i]}", refresh=False)
+        bar.update(weight[i])
 
     pool = None
     try:

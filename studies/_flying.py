@@ -165,7 +165,8 @@ def unpack(record: dict) -> dict:
         en = {k: np.asarray(log[k]) for k in ("kinetic", "strain", "work", "total", "balance")}
         en["t_blow_up"] = log["t_blow_up"]
     out.update(t=res.t, tip=np.asarray(res.monitors["tip"]["position"]).reshape(res.t.size, -1), energy=en,
-               stats=dict(res.stats), status=res.status, message=res.message, t_fail=res.t_fail, options=dict(res.options),
+               stats=dict(res.stats), status=res.status, message=res.message, t_fail=res.t_fail,
+               options=dict(res.options),
                monitors={k: v for k, v in res.monitors.items() if k not in ("tip", "energy")})
     return out
 

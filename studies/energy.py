@@ -139,7 +139,7 @@ def run(elements=None, integrators=None, n: int | None = None, t_end_b2=None, t_
             cases.append(Case(c, label=f"{name} {c['n']} el ({problem}) {integ}", cost=cost))
     cases.sort(key=lambda c: -c["cost"])
     sweep = run_cases(run_case, cases, out=path, executor=executor, jobs=jobs, reduce=unpack, name="energy",
-                      progress=progress)
+                      progress=progress, cost=lambda c: c["cost"])
     records = sweep.finished()
     key = {k: i for i, k in enumerate(INTEGRATORS)}
     records.sort(key=lambda r: (list(ELEMENTS).index(r["element"]), key[r["integrator"]]))

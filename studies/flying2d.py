@@ -121,7 +121,7 @@ def run(elements=None, n_elements=None, n_ref=None, n_elements_3d=None, t_end=No
     cases = [Case(c, t_end=o["t_end"], h=o["h"], dt_out=o["dt_out"], label=_label(c)) for c in cases]
     cases.sort(key=lambda c: -_COST[c["element"]] * c["n"])   # longest first: better balanced pools
     sweep = run_cases(run_case, cases, out=path, executor=executor, jobs=jobs, reduce=unpack, name="flying2d",
-                      progress=progress)
+                      progress=progress, cost=lambda c: _COST[c["element"]] * (c["n"] + 16))
     res = analyze(sweep.finished(), names, o["n_ref"], o["t_end"], o["h"], path if plots else None, sweep.errors)
     res.update(errors=sweep.errors, reused=sweep.reused, path=path)
     return res

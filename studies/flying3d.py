@@ -166,7 +166,8 @@ def _cases(o):
                       "t_end": o["t_end"], "h": o["h"]})
     if available(("SQ3D",)):
         for n in o["sq_meshes"]:
-            cases += [{"element": "SQ3D", "n": n, "t_end": o["t_end_sq"], "h": hs} for hs in (o["sq_steps"] or (o["h"],))]
+            cases += [{"element": "SQ3D", "n": n, "t_end": o["t_end_sq"], "h": hs}
+                      for hs in (o["sq_steps"] or (o["h"],))]
         if o["long_run"] and o["long_run"][0]:
             cases.append({"element": "SQ3D", "n": int(o["long_run"][0]), "t_end": float(o["long_run"][1]),
                           "h": o["h"], "long": True})
@@ -176,9 +177,13 @@ def _cases(o):
             + (f" {c['method']}" if c.get("method", "lobatto3") != "lobatto3" else "") \
             + f" h {c['h']:g} to {c['t_end']:g} s" + (" long" if c.get("long") else "")
         out.append(Case(c, dt_out=o["dt_out"], t_load=o["t_load"], label=label))
-    # SQ3D runs go to the end; BE3D runs usually stop early: start the long ones first.
-    out.sort(key=lambda c: -(c["t_end"] * c["n"] / c["h"] * (3.0 if c["element"] == "SQ3D" else 0.3)))
+    out.sort(key=lambda c: -_cost(c))      # the long ones first: better balanced pools
     return out
+
+
+def _cost(case):
+    # relative CPU cost; SQ3D runs go to the end, BE3D runs usually stop early
+    return case["t_end"] * case["n"] / case["h"] * (3.0 if case["element"] == "SQ3D" else 0.3)
 
 
 def run(be_meshes=None, sq_meshes=None, variants=None, variant_mesh=None, methods=None, long_run=None, t_end=None,
@@ -229,7 +234,7 @@ def run(be_meshes=None, sq_meshes=None, variants=None, variant_mesh=None, method
         raise ValueError("flying3d has no case to run: no BE3D/SQ3D meshes, or neither type in ancfdae.models.")
     path = output_dir("flying3d", out, quick) if (plots or out is not None) else None
     sweep = run_cases(run_case, cases, out=path, executor=executor, jobs=jobs, reduce=_unpack, name="flying3d",
-                      progress=progress)
+                      progress=progress, cost=_cost)
     records = sweep.finished()
     order = {"BE3D": 0, "SQ3D": 1}
     records.sort(key=lambda r: (order[r["element"]], r["director_update"] != o["variants"][0],

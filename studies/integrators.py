@@ -161,7 +161,7 @@ def run(models=None, element=None, n=None, t_end=None, dt_out=None, steps=None, 
     cases = _cases(o["models"], o["element"], o["n"], o["t_end"], o["dt_out"], o["steps"], o["rtols"],
                    o["newton_tols"], o["methods"], o["h_ref"])
     sweep = run_cases(run_case, cases, out=path, executor=executor, jobs=jobs, reduce=unpack, name="integrators",
-                      progress=progress)
+                      progress=progress, cost=lambda c: c["cost"])
     records = sweep.finished()
     t_end = o["t_end"]
     refs = {r["model"]: r for r in records if r["reference"]}
@@ -180,7 +180,8 @@ def run(models=None, element=None, n=None, t_end=None, dt_out=None, steps=None, 
                "eps_T": eps_T(r["t"], r["tip"], ref["t"], ref["tip"]) if r["status"] == "success" else float("nan"),
                "energy_error": float(np.nanmax(np.abs(bal - bal[0]))) if bal.size else float("nan"),
                "drift": steady_drift(r["t"], bal, T_PULSE)["max"] if t_end > T_PULSE else float("nan"),
-               "tol_sweep": bool(r.get("tol_sweep")), "max_order": r["stats"].get("max_order") or r.get("options", {}).get("max_order")}
+               "tol_sweep": bool(r.get("tol_sweep")),
+               "max_order": r["stats"].get("max_order") or r.get("options", {}).get("max_order")}
         rows.append(row)
     rows.sort(key=lambda r: (r["model"], list(METHODS).index(r["method"]) if r["method"] in METHODS else 99,
                              r["tol_sweep"], -(r["h"] or 0), -(r["rtol"] or 0), -(r["newton_tol"] or 0)))

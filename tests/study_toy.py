@@ -16,7 +16,8 @@ from ancfdae.studies._common import Case, markdown_table, output_dir, run_cases,
 NAME = "toy"
 FULL = dict(n_cases=4, sleep=0.01, fail=-1)
 QUICK = dict(n_cases=2)
-CLI_OPTIONS = [Option("n_cases", int, "number of cases"), Option("sleep", float, "seconds each fast case sleeps"), Option("fail", int, "case that raises")]
+CLI_OPTIONS = [Option("n_cases", int, "number of cases"), Option("sleep", float, "seconds each fast case sleeps"),
+               Option("fail", int, "case that raises")]
 
 
 def case_fn(case):

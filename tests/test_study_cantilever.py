@@ -24,7 +24,8 @@ def test_quick_study_reproduces_table2_be2d(tmp_path):
     chapter = lines["chapter Table 2, BE2D (= BE3D)"]
     np.testing.assert_allclose(chapter.get_ydata(), [cantilever.TABLE2["BE2D"][n][1] for n in sorted(
         cantilever.TABLE2["BE2D"])])
-    assert lines["BE3D"].get_markersize() > lines["BE2D"].get_markersize() and lines["BE3D"].get_markerfacecolor() == "none"
+    assert lines["BE3D"].get_markersize() > lines["BE2D"].get_markersize()
+    assert lines["BE3D"].get_markerfacecolor() == "none"
     assert f"BE2D fitted order {res['orders']['BE2D']:.2f} (x 0.5)" in lines
     # Fig. 6: the legend sits outside the axes (it covered points inside them)
     fig6 = res["figures"]["fig6_performance"]

@@ -38,7 +38,8 @@ def test_each_case_is_stored_and_a_rerun_reuses_it(tmp_path):
 def test_a_case_that_raises_is_recorded_and_the_others_go_on(tmp_path):
     res = study_toy.run(out=tmp_path, fail=1, progress=False)
     sweep = res["sweep"]
-    assert sweep.records[1] is None and sweep.errors == {"case 1": "RuntimeError: case 1 is broken"}
+    assert sweep.records[1] is None and list(sweep.errors) == ["case 1"]
+    assert sweep.errors["case 1"].startswith("RuntimeError: case 1 is broken (at study_toy.py:")   # where it raised
     assert [r["square"] for r in sweep.finished()] == [0, 4, 9]
     assert "RuntimeError" in json.loads((tmp_path / "cases" / "case_1.json").read_text())["error"]
     again = study_toy.run(out=tmp_path, fail=1, progress=False)
@@ -48,6 +49,8 @@ def test_a_case_that_raises_is_recorded_and_the_others_go_on(tmp_path):
 def test_a_case_that_raises_in_a_worker_is_recorded(tmp_path):
     res = study_toy.run(out=tmp_path, fail=0, jobs=2, progress=False)
     assert list(res["sweep"].errors) == ["case 0"] and len(res["sweep"].finished()) == 3
+    error = res["sweep"].errors["case 0"]
+    assert "RuntimeError: case 0 is broken" in error and "study_toy.py" in error     # the worker's traceback
 
 
 def test_output_folder_checked_before_any_work(tmp_path, monkeypatch, capsys):
