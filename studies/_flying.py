@@ -163,7 +163,9 @@ def unpack(record: dict) -> dict:
     if "energy" in res.monitors:
         log = res.monitors["energy"]
         en = {k: np.asarray(log[k]) for k in ("kinetic", "strain", "work", "total", "balance")}
-        en["t_blow_up"] = log["t_blow_up"]
+        t_blow = log.get("t_blow_up")
+        # None when no blow-up; a file format without null may give NaN back
+        en["t_blow_up"] = None if t_blow is None or not np.isfinite(t_blow) else float(t_blow)
     out.update(t=res.t, tip=np.asarray(res.monitors["tip"]["position"]).reshape(res.t.size, -1), energy=en,
                stats=dict(res.stats), status=res.status, message=res.message, t_fail=res.t_fail,
                options=dict(res.options),
