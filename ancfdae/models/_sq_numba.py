@@ -13,6 +13,13 @@ are allocated once per call, never per point.
 
 Importing this module imports numba; :mod:`ancfdae.models._sq_common` does so
 only when the compiled kernel is selected.
+
+numba's on-disk cache is keyed on the source file of the cached function
+only: after editing a function it calls from another file
+(:mod:`~ancfdae.models._jet_numba`, :mod:`~ancfdae.models._sq_numba_structural`,
+:mod:`~ancfdae.models._sq_numba_continuum`), delete the ``*.nbi``/``*.nbc``
+files in ``ancfdae/models/__pycache__``, or the old code keeps running (the
+same holds for :mod:`~ancfdae.models._sq_numba_moment`).
 """
 from __future__ import annotations
 
