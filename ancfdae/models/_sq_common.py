@@ -373,7 +373,8 @@ def _numba_geometry(formulation, dim, n_strain, geom):
             full_r[:, :, g["which"]] = g["ref"].reshape(n_el, P, -1)
             Dw.append(full_D)
             ref.append(full_r)
-        return N, dN, np.ascontiguousarray(np.concatenate(Dw, axis=1)), np.ascontiguousarray(np.concatenate(ref, axis=1))
+        return (N, dN, np.ascontiguousarray(np.concatenate(Dw, axis=1)),
+                np.ascontiguousarray(np.concatenate(ref, axis=1)))
     (g,) = groups
     Pc = g["Pc"]
     S, _, nb = Pc.shape
