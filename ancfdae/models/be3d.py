@@ -79,7 +79,18 @@ class BE3D(Element):
         Update the directors only when at some node the sine of the angle
         between director and axis (the norm of the projection of Eq. 99 of
         the unit director) falls below this value; None (default) updates
-        after every step, as the chapter does.
+        after every step, as the chapter does. The fixed-step integrators
+        carry on through an update at no cost; IDA re-initialises (order 1,
+        small first step) and needs the threshold. Measured on B3 (2
+        elements, IDA rtol 1e-6): after every step, 20,000 steps and as many
+        restarts reached t = 0.055 s in 100 s CPU; with 0.5, the run to 3 s
+        took 1,031 steps, no restart, 1.45 s CPU; with 0.9, 1,246 steps and 3
+        restarts, 1.87 s. 0.5 keeps the projection well conditioned (angle
+        between director and axis >= 30 degrees). When the directors are
+        updated changes the motion by a discretisation error that vanishes
+        with the mesh (O(h^2) in the strain energy): on this 2-element mesh
+        the tip of B after 3 s differed by 2e-2 m between the update after
+        every step (Lobatto IIIA, h = 1e-3) and none.
     kernel : {"auto", "numpy", "numba"}
         Implementation of the strain energy, internal forces and rotary
         inertia. ``"numba"``: compiled loops over elements x points
