@@ -53,6 +53,19 @@ class ButcherTableau:
     finite entries, the row-sum condition ``c_i = sum_j a_ij``, and the
     quadrature conditions ``sum_i b_i c_i^(k-1) = 1/k`` for ``k = 1..order``
     (necessary for the declared order).
+
+    Parameters
+    ----------
+    a : array_like, shape (s, s)
+        Runge-Kutta matrix.
+    b : array_like, shape (s,)
+        Weights.
+    c : array_like, shape (s,)
+        Nodes.
+    order : int
+        Declared order of the method.
+    name : str
+        Label used in messages.
     """
 
     a: np.ndarray
