@@ -12,7 +12,8 @@ coordinates ``time``, ``node`` (node index of each coordinate) and
 ``status``, ``message``, ``method``, ``t_fail``, the JSON texts ``stats``,
 ``options``, ``monitor_scalars`` and ``model`` (the beam description), and
 readable copies ``element``, ``formulation``, ``material``, ``section``,
-``loads``, ``unit_system``.
+``loads``, ``unit_system``; the mesh also as the variables ``reference_nodes``
+``(mesh_node, space)`` and ``element_nodes`` ``(element, element_node)``.
 
 Engine
 ------
@@ -62,9 +63,12 @@ def _jsonable(obj):
     return obj
 
 
-def _dump(obj) -> str:
+def _dump(obj, what: str = "value") -> str:
     # allow_nan keeps NaN/inf statistics (e.g. a drift of an empty run); json reads them back.
-    return json.dumps(_jsonable(obj), allow_nan=True)
+    try:
+        return json.dumps(_jsonable(obj), allow_nan=True)
+    except TypeError as exc:
+        raise ValueError(f"Result.{what} must be JSON-able to be saved: {exc}.") from None
 
 
 def describe_model(model) -> dict:
@@ -139,8 +143,8 @@ def to_dataset(result):
     attrs = {
         "format": FORMAT, "status": result.status, "message": result.message, "method": result.method,
         "t_fail": math.nan if result.t_fail is None else float(result.t_fail),
-        "stats": _dump(result.stats), "options": _dump(result.options),
-        "monitor_scalars": _dump(scalars), "model": _dump(model), "unit_system": _UNITS,
+        "stats": _dump(result.stats, "stats"), "options": _dump(result.options, "options"),
+        "monitor_scalars": _dump(scalars, "monitors"), "model": _dump(model, "model"), "unit_system": _UNITS,
     }
     for key in ("formulation",):
         if key in model:
@@ -148,6 +152,11 @@ def to_dataset(result):
     for key in ("element", "material", "section", "loads"):
         if key in model:
             attrs[key] = _dump(model[key])
+    if "nodes" in model:    # the mesh as arrays too, for readers that do not parse the JSON description
+        data["reference_nodes"] = (("mesh_node", "space"), np.asarray(model["nodes"], dtype=float),
+                                   {"long_name": "reference positions of the nodes (the dof coordinate 'node')"})
+        data["element_nodes"] = (("element", "element_node"), np.asarray(model["element_nodes"], dtype=np.int64),
+                                 {"long_name": "nodes of each element (3-node elements: start, end, middle)"})
     ds = xr.Dataset(data, coords={"time": ("time", result.t), "node": ("dof", node),
                                   "coordinate": ("dof", coord)}, attrs=attrs)
     ds["time"].attrs["long_name"] = "output time"

@@ -76,9 +76,7 @@ def section_vectors(beam, q: np.ndarray, directors: np.ndarray | None = None):
         a_zeta = Q[:, 2 * dim:3 * dim] if dim == 3 else ez
         return r, a_eta, np.array(a_zeta)
     if name == "BE3D":
-        geom = dict(beam.geom)
-        if directors is not None:
-            geom["directors"] = np.asarray(directors, dtype=float)
+        geom = beam.geom if directors is None else el.bind(beam.geom, {"directors": directors})
         qe = beam.expand(q)[beam.edofs]
         F = el.frames(geom, qe, np.array([-1.0, 1.0]))            # (n_el, 2, 3, 3)
         e2, e3 = np.empty_like(r), np.empty_like(r)

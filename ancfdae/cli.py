@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import inspect
 import pkgutil
 import sys
 
@@ -88,11 +87,10 @@ def main(argv: list[str] | None = None) -> int:
                                      "ParaView export and animations.")
     parser.add_argument("--version", action="version", version=f"ancfdae {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
-    st = sub.add_parser("study", help="run a study (writes markdown tables and PNG figures)")
+    st = sub.add_parser("study", help="run a study (see `ancfdae study NAME --help` for its options)",
+                        add_help=False)
     st.add_argument("name", help="study name (see `ancfdae studies`)")
-    st.add_argument("--quick", action="store_true", help="small, fast version (what the tests run)")
-    st.add_argument("--out", default=None, help="output folder (default out/NAME)")
-    st.add_argument("--jobs", type=int, default=None, help="parallel worker processes for sweeps")
+    st.add_argument("options", nargs=argparse.REMAINDER, help="the study's options")
     sub.add_parser("studies", help="list the studies")
     ex = sub.add_parser("export", help="export a result file (ParaView)")
     ex_sub = ex.add_subparsers(dest="format", required=True)
@@ -116,20 +114,8 @@ def main(argv: list[str] | None = None) -> int:
             doc = (_load(name).__doc__ or "").strip().splitlines()
             print(f"{name:14s} {doc[0] if doc else ''}")
         return 0
-    module = _load(args.name)
-    options = {"quick": args.quick, "out": args.out}
-    if args.jobs is not None:
-        if "jobs" not in inspect.signature(module.run).parameters:
-            raise SystemExit(f"ancfdae: study {args.name!r} runs serially; it has no --jobs option")
-        if args.jobs < 1:
-            raise SystemExit(f"ancfdae: --jobs must be a positive integer, got {args.jobs}")
-        options["jobs"] = args.jobs
-    result = module.run(**options)
-    if result.get("table"):
-        print(result["table"])
-    if result.get("path") is not None:
-        print(f"results written to {result['path']}")
-    return 0
+    from ancfdae.studies import _cli
+    return _cli.main(_load(args.name), args.options, prog=f"ancfdae study {args.name}")
 
 
 if __name__ == "__main__":

@@ -48,15 +48,6 @@ class Monitor:
         """
         self.model = model
 
-    def rebind(self, model: Any) -> None:
-        """Use ``model`` (bound to a new event state, e.g. BE3D's directors) from now on.
-
-        Parameters
-        ----------
-        model : Model
-        """
-        self.model = model
-
     def advance(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, nodes: tuple | None = None) -> None:
         """Account for one accepted step ending at ``t``.
 
@@ -69,6 +60,15 @@ class Monitor:
             ``(ts, Q, V, w)``: the step's quadrature (times, stage coordinates
             and velocities as rows, weights summing to the step size).
         """
+
+    def rebind(self, model: Any) -> None:
+        """Use ``model`` (bound to a new event state) from now on.
+
+        Parameters
+        ----------
+        model : Model
+        """
+        self.model = model
 
     def sample(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> None:
         """Record the state at an output time (inside the last advanced step).

@@ -15,8 +15,8 @@ from ancfdae.integrators.driver import integrate
 from ancfdae.integrators.ida import IDA
 from ancfdae.integrators.lobatto import LobattoIIIA
 from ancfdae.integrators.newmark import GeneralizedAlpha, HHTAlpha, Newmark
-from ancfdae.integrators.protocol import Integrator
 from ancfdae._resultfile import describe_model
+from ancfdae.integrators.protocol import Integrator
 from ancfdae.result import Result
 
 __all__ = ["simulate", "METHODS"]
@@ -147,7 +147,7 @@ def simulate(model, t_span, method="lobatto3", h=None, t_eval=None, monitors=(),
     """
     stepper = _build(model, method, h, options)
     result = integrate(stepper, model, t_span, t_eval=t_eval, monitors=monitors, hooks=hooks, q0=q0, v0=v0,
-                     state0=state0, max_steps=max_steps, progress=bool(progress))
+                       state0=state0, max_steps=max_steps, progress=bool(progress))
     if not result.model:   # the model's self-description, for self-describing result files
         result.model = describe_model(model)
     return result

@@ -2,9 +2,10 @@
 
 ``python -m benchmarks.jit_cost [--runs 3]`` starts fresh interpreters with an empty numba cache
 directory (cold: compile) and again with the directory the first one filled (warm: load), and prints
-the median first-call time (wall clock and CPU time) of each compiled kernel -- BE2D forces, Cable3D energy/forces/tangent,
-BE3D energy/forces/tangent, rotary inertia with its Jacobian blocks, rotary kinetic energy -- and
-their sum. Timings only; nothing is asserted.
+the median first-call time (wall clock and CPU time) of each compiled kernel -- BE2D forces,
+Cable3D energy/forces/tangent, BE3D energy/forces/tangent, rotary inertia with its Jacobian blocks,
+rotary kinetic energy, dead-moment load -- and their sum. The first kernel's time includes importing
+numba. Timings only; nothing is asserted.
 """
 from __future__ import annotations
 
@@ -35,6 +36,7 @@ for cls, s in ((BE2D, RectangularSection(0.1)), (Cable3D, RectangularSection(0.1
     if cls is BE3D:
         first("BE3D inertia+blocks", lambda: el.inertia(g, qe, qe, qe, True))
         first("BE3D kinetic energy", lambda: el.kinetic_energy_extra(g, qe, qe))
+        first("BE3D moment load", lambda: el.moment_load(g, qe[0], 0.3, np.ones(3), 0, True))
 print(json.dumps(out))
 """
 

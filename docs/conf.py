@@ -27,6 +27,7 @@ numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
 myst_heading_anchors = 3
 html_theme = "alabaster"
+html_theme_options = {"page_width": "1240px", "sidebar_width": "240px"}
 nitpicky = False
 suppress_warnings = ["myst.header"]
 

@@ -18,7 +18,7 @@ __all__ = ["cable3d_forces", "cable3d_element", "cable3d_scratch"]
 
 
 @njit(cache=True, inline="always")
-def _bending_point(f, K, q, dof, dN, ddN, wdx, EI, a, b, idx, coef, grad, H, tangent):
+def _bending_point(f, K, q, dof, dN, ddN, wdx, EI, a, b, ga, gb, idx, coef, grad, H, tangent):
     """``EI/2 K^2 w`` at a point: adds force and tangent, returns the energy."""
     slope(q, dof, dN, a)
     slope(q, dof, ddN, b)
@@ -28,8 +28,6 @@ def _bending_point(f, K, q, dof, dN, ddN, wdx, EI, a, b, idx, coef, grad, H, tan
     g = p * bb - ab * ab
     c = 0.5 * EI * wdx
     p2, p3 = p * p, p * p * p
-    ga = np.empty(3)
-    gb = np.empty(3)
     for i in range(3):
         ga[i] = 2.0 * (a[i] * bb - ab * b[i])
         gb[i] = 2.0 * (b[i] * p - ab * a[i])
@@ -57,8 +55,8 @@ def _bending_point(f, K, q, dof, dN, ddN, wdx, EI, a, b, idx, coef, grad, H, tan
 @njit(cache=True, inline="always")
 def cable3d_scratch():
     """Work arrays of :func:`cable3d_element` (allocated once per kernel call, not per element)."""
-    return (np.empty(3), np.empty(3), np.zeros((6, 4), dtype=np.int64), np.zeros((6, 4)), np.zeros(6),
-            np.zeros((6, 6)))
+    return (np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.zeros((6, 4), dtype=np.int64),
+            np.zeros((6, 4)), np.zeros(6), np.zeros((6, 6)))
 
 
 @njit(cache=True, inline="always")
@@ -69,12 +67,12 @@ def cable3d_element(f, K, q, dof, dNa, wa, slope_ref, dNb, ddNb, wb, EA, EI, tan
     ``ddNb`` (n_b, 4), ``wb`` (n_b,): the bending rule; ``scratch`` from
     :func:`cable3d_scratch`. Returns the element's strain energy.
     """
-    a, b, idx, coef, grad, H = scratch
+    a, b, ga, gb, idx, coef, grad, H = scratch
     U = 0.0
     for p in range(wa.size):
         U += axial_point(f, K, q, dof, dNa[p], wa[p], slope_ref[p], EA, a, idx, coef, grad, H, tangent)
     for p in range(wb.size):
-        U += _bending_point(f, K, q, dof, dNb[p], ddNb[p], wb[p], EI, a, b, idx, coef, grad, H, tangent)
+        U += _bending_point(f, K, q, dof, dNb[p], ddNb[p], wb[p], EI, a, b, ga, gb, idx, coef, grad, H, tangent)
     return U
 
 

@@ -207,15 +207,15 @@ class Element(ABC):
         """Kinetic energy beyond ``1/2 v^T M_const v``, shape (n_el,)."""
         return np.zeros(len(q))
 
-    def event_state(self, geom) -> dict:
+    def event_state(self, geom: Any) -> dict:
         """The element's event state in ``geom`` (arrays that may change between steps); none by default."""
         return {}
 
-    def bind(self, geom, state: dict) -> dict:
+    def bind(self, geom: Any, state: dict) -> Any:
         """A geometry equal to ``geom`` but with the event ``state`` (``geom`` is not changed)."""
         return geom
 
-    def step_event(self, geom, Q: np.ndarray, V: np.ndarray):
+    def step_event(self, geom: Any, Q: np.ndarray, V: np.ndarray) -> tuple | None:
         """Event after an accepted time or load step (BE3D's director update); None = nothing changed.
 
         ``Q``, ``V``: full nodal coordinate and velocity arrays, shape

@@ -14,7 +14,7 @@ from .._validate import choice
 from ..materials import CircularSection, Material, RectangularSection
 from ._element import Element
 from ._quadrature import gauss
-from ._kernel_option import resolve_kernel as _resolve_kernel
+from ._kernel_option import resolve_kernel
 from ._sq_kernels import assemble, continuum_kernel, local_map, rule, shapes, structural_kernel, voigt
 
 __all__ = ["SQElement", "shear_factors"]
@@ -68,7 +68,7 @@ class SQElement(Element):
 
     @kernel.setter
     def kernel(self, value):
-        self._impl = _resolve_kernel(value)
+        self._impl = resolve_kernel(value)
         self._kernel = value
 
     @property

@@ -92,7 +92,7 @@ class Beam:
         if not isinstance(element, Element):
             raise TypeError(f"`element` must be an ancfdae element (e.g. BE2D(...)), got {element!r}.")
         self.element = element
-        self.normal, self.loads = normal, tuple(loads)   # kept for describe()
+        self.normal = normal   # kept for describe()
         dim = element.dim
         npe = element.n_nodes
         if nodes is not None:
@@ -167,7 +167,8 @@ class Beam:
         elif not isinstance(loads, Iterable):
             raise TypeError(f"`loads` must be a load or a sequence of loads (PointForce, PointMoment, Gravity, "
                             f"DistributedLoad), got {loads!r}.")
-        self._setup_loads(loads)
+        self.loads = tuple(loads)   # kept for describe()
+        self._setup_loads(self.loads)
         # Gather of the element coordinates from (free q, fixed reference values) in one take.
         ext_of_full = free_of_full.copy()
         ext_of_full[fixed] = self.n_dof + np.arange(int(fixed.sum()))
@@ -325,11 +326,12 @@ class Beam:
         """Shape checks of the contract's arguments: a wrong length would otherwise assemble silently
         into a wrong-sized residual or fail deep inside numpy."""
         n = (self.n_dof,)
-        if np.shape(q) != n:
+        # Attribute access for arrays (tens of ns); anything else goes through np.shape in check_shape.
+        if getattr(q, "shape", None) != n:
             check_shape("q", q, n, f"n_dof = {self.n_dof}")
-        if v is not None and np.shape(v) != n:
+        if v is not None and getattr(v, "shape", None) != n:
             check_shape("v", v, n, f"n_dof = {self.n_dof}")
-        if a is not None and np.shape(a) != n:
+        if a is not None and getattr(a, "shape", None) != n:
             check_shape("a", a, n, f"n_dof = {self.n_dof}")
 
     def initial_state(self):
