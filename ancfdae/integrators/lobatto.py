@@ -273,10 +273,12 @@ class LobattoIIIA(FixedStepIntegrator):
                     R[:, i] = self._residual(ts[i], Q[:, i], V_[:, i], X[:, i])
                 return R.ravel()
 
+            eigen = [self.newton.options.jacobian == "modified"]
+
             def jacobian(x):
                 X = x.reshape(n, m)
                 Q, V_ = Q0 + X @ CQ, V0 + X @ CV
-                if self.newton.options.jacobian == "modified":
+                if eigen[0]:
                     # Modified Newton reuses the matrix across steps anyway: one set of blocks (at
                     # the last stage) lets the stage system split in the tableau's eigenbasis.
                     blk = self._jacobian(ts[-1], Q[:, -1], V_[:, -1], X[:, -1])
@@ -291,7 +293,14 @@ class LobattoIIIA(FixedStepIntegrator):
                     self._set_floor(blk, Q[:, i])
                 return self._matrix(blocks, h)
 
-        out = self.newton.solve(residual, jacobian, self._guess(h).ravel())
+        guess = self._guess(h).ravel()
+        out = self.newton.solve(residual, jacobian, guess)
+        if not out.converged and m > 1 and eigen[0]:
+            # The one-state eigenbasis matrix can be too crude where the stages differ much (large
+            # steps, strong nonlinearity): before failing, retry the step with the exact per-stage matrix.
+            eigen[0] = False
+            self.newton.invalidate()
+            out = self.newton.solve(residual, jacobian, guess)
         if not out.converged:
             return False, f"Newton: {out.message}"
         X = out.x.reshape(n, m)
