@@ -6,7 +6,7 @@ convergence", i.e. Lobatto IIIA with s = 3 stages, with a modified Newton
 method on each step. s = 2 is the trapezoidal rule (order 2).
 
 The s-stage method is applied to ``q' = v, v' = a`` with ``r(t, q, v, a) = 0``
-(design.md Sect. 3) and the stage accelerations ``A_i`` as unknowns::
+(the Model contract's residual) and the stage accelerations ``A_i`` as unknowns::
 
     V_i = v_n + h sum_j a_ij A_j
     Q_i = q_n + c_i h v_n + h^2 sum_j (a^2)_ij A_j
@@ -98,14 +98,17 @@ class ButcherTableau:
 
     @property
     def stages(self) -> int:
+        """Number of stages ``s``."""
         return self.a.shape[0]
 
     @property
     def explicit_first_stage(self) -> bool:
+        """True when the first row of ``a`` is zero."""
         return bool(np.all(self.a[0] == 0.0))
 
     @property
     def stiffly_accurate(self) -> bool:
+        """True when the last row of ``a`` equals ``b``."""
         return bool(np.array_equal(self.a[-1], self.b))
 
 
