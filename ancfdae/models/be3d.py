@@ -15,7 +15,7 @@ from ._be3d_dynamics import UPDATES, rotary_inertia, rotary_kinetic_energy
 from ._be3d_events import BE3DEvents
 from ._be3d_kinematics import curvature_energy, curvatures, director_field, frames, spin_gradient
 from ._element import Element
-from ._kernel_option import resolve_kernel
+from ._kernel_option import KernelOption
 from ._scalar_jet import Jet
 from ._shapes import hermite, linear
 from ._thin import (PointRule, assemble, axial_energy, check_material_section, clamp_coordinates,
@@ -31,7 +31,7 @@ _NDOF = 14
 _PARALLEL_TOL = 1e-6
 
 
-class BE3D(BE3DEvents, Element):
+class BE3D(KernelOption, BE3DEvents, Element):
     """Spatial thin ANCF beam with torsional stiffness (chapter Sects. 3.5-3.6).
 
     Frame (Eqs. 96-100): ``e1 = r'/|r'|``; ``e30`` the normalised projection
@@ -135,21 +135,6 @@ class BE3D(BE3DEvents, Element):
         self.rhoJ = material.rho * section.J
         self._pending = None
         self.kernel = kernel
-
-    @property
-    def kernel(self) -> str:
-        """The ``kernel`` option as given ("auto", "numpy" or "numba")."""
-        return self._kernel
-
-    @kernel.setter
-    def kernel(self, value):
-        self._impl = resolve_kernel(value)
-        self._kernel = value
-
-    @property
-    def kernel_in_use(self) -> str:
-        """The implementation that runs: "numpy" or "numba"."""
-        return self._impl
 
     def __repr__(self):
         return (f"BE3D(director_update={self.director_update!r}, axial_points={self.axial_points}, "
