@@ -5,7 +5,7 @@ The B2 beam (the project's definition; a small mesh of BE2D) and a stiffer varia
 over [0, T] by Lobatto IIIA with 3 and 2 stages (modified and full Newton),
 Newmark (beta 1/4, gamma 1/2), HHT (alpha 0.05), generalized-alpha
 (rho_inf 0.8) over a range of step sizes, by Lobatto IIIA (3 stages) over a
-range of Newton tolerances, and by IDA (BDF, max order 2, undamped model)
+range of Newton tolerances, and by IDA (BDF, max order 5)
 over a range of relative tolerances. The error of a run is the integrated tip
 error of chapter Eq. 115 against a fine reference (Lobatto IIIA, 3 stages,
 h = 1.25e-4 s, full Newton, tol 1e-10; T = 4 s, so the pulse -- 2.5 s -- and
