@@ -15,7 +15,7 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["Model", "JacobianBlocks", "Energy"]
+__all__ = ["Model", "JacobianBlocks", "Energy", "PotentialModel"]
 
 
 @dataclass(frozen=True)
@@ -138,3 +138,46 @@ def accept_step(model, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarr
     if hook is None:
         return q, v
     return hook(t, q, v)
+
+
+# -- optional capability: the potential, for energy-momentum integrators ---------------------
+@runtime_checkable
+class PotentialModel(Protocol):
+    """What a structure-preserving (discrete-gradient) integrator needs beyond :class:`Model`.
+
+    The residual splits as ``r = M a + dP/dq - f_nc(t, q)`` with a *constant* mass
+    matrix, the conservative potential ``P = U + V`` (strain energy plus the
+    potential of the conservative loads, i.e. gravity) and the non-conservative
+    loads ``f_nc`` (dead forces, moments). Optional: an integrator that needs it
+    checks for these members and raises a ValueError naming the missing one.
+
+    Attributes
+    ----------
+    potential_degree : int or None
+        Polynomial degree of ``P`` in ``q`` when ``P`` is a polynomial (4 for
+        the St. Venant-Kirchhoff continuum formulations, whose Green strain is
+        quadratic in ``q``), else None.
+    """
+
+    potential_degree: int | None
+
+    def potential(self, t: float, q: np.ndarray) -> float:
+        """``P(q) = U(q) + V(q)`` (equal to ``energy(t, q, v).strain + .potential``)."""
+        ...
+
+    def potential_gradient(self, t: float, q: np.ndarray, tangent: bool = True):
+        """``(dP/dq, d2P/dq2 as a sparse matrix or None)``."""
+        ...
+
+    def nonconservative_force(self, t: float, q: np.ndarray, tangent: bool = True):
+        """``(f_nc(t, q), df_nc/dq as a sparse matrix or None)``; ``external_power = f_nc . v``."""
+        ...
+
+    def symmetry_generators(self):
+        """Rigid motions that leave the strain energy unchanged: ``(T, A)``.
+
+        ``T`` (n_dof, k_t): constant translation directions; ``A``: list of
+        sparse skew matrices, the infinitesimal rotations ``q -> A q`` (rotating
+        every nodal vector). Both empty when supports break the symmetry.
+        """
+        ...

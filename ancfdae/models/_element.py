@@ -50,6 +50,11 @@ class Element(ABC):
         False only for elements whose mass matrix depends on q (BE3D).
     formulations : tuple of str
         The formulation variants the element offers.
+    energy_degree : int or None
+        Degree of the strain energy as a polynomial in the element
+        coordinates, or None when it is not a polynomial (an energy-momentum
+        integrator integrates the gradient of a polynomial energy exactly
+        along the step with a Gauss rule).
 
     Instance attributes ``material`` (:class:`ancfdae.materials.Material`)
     and ``section`` (a section of :mod:`ancfdae.materials`) are required: the
@@ -62,6 +67,7 @@ class Element(ABC):
     node_coordinates: ClassVar[tuple[str, ...]]
     mass_is_constant: ClassVar[bool] = True
     formulations: ClassVar[tuple[str, ...]] = ("structural",)
+    energy_degree: ClassVar[int | None] = None
 
     @property
     def n_nodes(self) -> int:

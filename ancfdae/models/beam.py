@@ -18,12 +18,13 @@ from ..problem import Energy, JacobianBlocks
 from ._assembly import Assembler
 from ._element import Element
 from ._mesh import mesh_from_points, straight_mesh
+from ._potential import PotentialMixin
 from ._quadrature import gauss
 
 __all__ = ["Beam"]
 
 
-class Beam:
+class Beam(PotentialMixin):
     """A beam of ANCF elements with supports and loads: a Model.
 
     Parameters
@@ -63,6 +64,11 @@ class Beam:
     ----------
     n_dof : int
         Free coordinates.
+
+    Notes
+    -----
+    Also a :class:`ancfdae.problem.PotentialModel` (methods of
+    :class:`~ancfdae.models._potential.PotentialMixin`).
     load_factor : float
         Multiplies every external load (the static solver steps it).
     """
