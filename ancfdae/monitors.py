@@ -5,12 +5,16 @@ Every integrator drives a monitor through four calls:
 ``start(model, t0, q0, v0, a0)``
     once, before the first step;
 ``advance(t, q, v, a, nodes=None)``
-    after every accepted step (on IDA: every internal step), with an
-    optional quadrature of the step, ``nodes = (ts, Q, V, w)`` (times, stage
-    coordinates and velocities as rows, weights that sum to the step size),
-    for integrals over the step;
+    after every accepted step (on IDA: every internal step), with the
+    step's quadrature when the integrator has one, an
+    :class:`ancfdae.integrators.protocol.Quadrature` ``(t, q, v, w)`` (node
+    times, coordinates and velocities as rows, weights that sum to the step
+    size), for integrals over the step;
 ``sample(t, q, v, a)``
     at every output time (``t`` lies in the last advanced step);
+``rebind(model)`` (optional)
+    after a model event (BE3D's director update) with the model bound to
+    the new event state, so that later evaluations use it;
 ``log()``
     the arrays (one entry per output time) and scalars stored in
     ``Result.monitors[name]``.
@@ -36,6 +40,10 @@ class Monitor:
 
     def advance(self, t, q, v, a, nodes=None) -> None:  # noqa: D102
         pass
+
+    def rebind(self, model) -> None:
+        """Use ``model`` (bound to a new event state) from now on."""
+        self.model = model
 
     def sample(self, t, q, v, a) -> None:  # noqa: D102
         pass

@@ -55,6 +55,10 @@ class Result:
         Name of the integrator.
     options : dict
         The integrator's options (JSON-able), for the record.
+    model_state : dict
+        The model's event state at ``t`` (models with the ``"step_events"`` capability):
+        ``{name: ndarray of shape (n_out, ...)}``, e.g. BE3D's ``"directors"``, shape
+        ``(n_out, n_nodes, 3)``. Empty for models without event state.
     """
 
     t: np.ndarray
@@ -68,6 +72,7 @@ class Result:
     t_fail: float | None = None
     method: str = ""
     options: dict = field(default_factory=dict)
+    model_state: dict = field(default_factory=dict)
 
     def __post_init__(self):
         if self.status not in _STATUSES:
@@ -81,6 +86,14 @@ class Result:
             if arr.ndim != 2 or arr.shape[0] != n:
                 raise ValueError(f"`{name}` must have shape ({n}, n_dof) to match `t`, got {arr.shape}.")
             setattr(self, name, arr)
+        state = {}
+        for key, arr in dict(self.model_state or {}).items():
+            arr = np.asarray(arr, dtype=float)
+            if arr.ndim < 1 or arr.shape[0] != n:
+                raise ValueError(f"`model_state[{key!r}]` must have {n} rows (one per output time), "
+                                 f"got shape {arr.shape}.")
+            state[str(key)] = arr
+        self.model_state = state
 
     @property
     def success(self) -> bool:
@@ -106,6 +119,8 @@ class Result:
             path = path.with_name(path.name + ".npz")
         arrays = {"t": self.t, "q": self.q, "v": self.v, "a": self.a}
         scalars: dict = {}
+        for key, arr in self.model_state.items():
+            arrays[f"state/{key}"] = arr
         for name, log in self.monitors.items():
             if "/" in name:
                 raise ValueError(f"monitor names must not contain '/', got {name!r}.")
@@ -137,10 +152,12 @@ class Result:
             if meta.get("format") != "ancfdae.Result/1":
                 raise ValueError(f"{path} is not an ancfdae Result file (format {meta.get('format')!r}).")
             monitors = {name: dict(vals) for name, vals in meta["monitor_scalars"].items()}
+            state = {key.split("/", 1)[1]: data[key] for key in data.files if key.startswith("state/")}
             for key in data.files:
                 if key.startswith("monitor/"):
                     _, name, entry = key.split("/", 2)
                     monitors.setdefault(name, {})[entry] = data[key]
             return cls(t=data["t"], q=data["q"], v=data["v"], a=data["a"], status=meta["status"],
                        message=meta["message"], stats=meta["stats"], monitors=monitors,
-                       t_fail=meta["t_fail"], method=meta["method"], options=meta["options"])
+                       t_fail=meta["t_fail"], method=meta["method"], options=meta["options"],
+                       model_state=state)

@@ -8,7 +8,7 @@ import numpy as np
 
 from ._validate import positive_int
 from .integrators._newton import NewtonOptions, NewtonSolver, NewtonStats
-from .problem import accept_step
+from .problem import capabilities
 
 __all__ = ["solve_static", "StaticResult"]
 
@@ -32,6 +32,9 @@ class StaticResult:
     stats : NewtonStats
     cpu_time : float
         Process time of the solve in seconds.
+    state : dict
+        The model's event state after the last converged load step (models with the
+        ``"step_events"`` capability, e.g. BE3D's ``{"directors": ...}``); empty otherwise.
     """
 
     q: np.ndarray
@@ -41,6 +44,7 @@ class StaticResult:
     steps: list = field(default_factory=list)
     stats: NewtonStats = field(default_factory=NewtonStats)
     cpu_time: float = 0.0
+    state: dict = field(default_factory=dict)
 
     @property
     def success(self) -> bool:
@@ -83,6 +87,9 @@ def solve_static(model, load_steps: int = 10, *, t: float = 0.0, q0=None, tol: f
         raise ValueError("`model` must have a `load_factor` attribute for load stepping; "
                          f"use load_steps=1 with {type(model).__name__}.")
     solver = NewtonSolver(NewtonOptions(tol=tol, atol=atol, max_iter=max_iter, jacobian=jacobian))
+    caps = capabilities(model)
+    state = model.event_state() if "step_events" in caps else {}
+    m = model.bind(state) if state else model   # the model is never changed; the state is carried here
     q = model.initial_state()[0].copy() if q0 is None else np.array(q0, dtype=float)
     if q.shape != (model.n_dof,):
         raise ValueError(f"`q0` must have shape ({model.n_dof},), got {q.shape}.")
@@ -94,13 +101,13 @@ def solve_static(model, load_steps: int = 10, *, t: float = 0.0, q0=None, tol: f
         for i in range(1, load_steps + 1):
             lam = i / load_steps
             if saved is not None:
-                model.load_factor = saved * lam
+                m.load_factor = saved * lam
             fused = None
-            if hasattr(model, "residual_jacobian"):
-                def fused(x):
-                    r, J = model.residual_jacobian(t, x, z, z)
+            if "residual_jacobian" in caps:
+                def fused(x, m=m):
+                    r, J = m.residual_jacobian(t, x, z, z)
                     return r, J.K
-            out = solver.solve(lambda x: model.residual(t, x, z, z), lambda x: model.jacobian(t, x, z, z).K, q,
+            out = solver.solve(lambda x, m=m: m.residual(t, x, z, z), lambda x, m=m: m.jacobian(t, x, z, z).K, q,
                                residual_jacobian=fused)
             steps.append({"load_factor": lam, "iterations": out.iterations, "residual": out.residual_norm,
                           "converged": out.converged, "q": out.x if out.converged else q.copy()})
@@ -109,10 +116,14 @@ def solve_static(model, load_steps: int = 10, *, t: float = 0.0, q0=None, tol: f
                 message = (f"load step {i} of {load_steps} (load factor {lam:g}) did not converge: "
                            f"{out.message}; max|r| = {out.residual_norm:.3e}")
                 break
-            q, _ = accept_step(model, t, out.x, z)
+            q = out.x
+            ev = m.step_event(t, q, z) if state else None
+            if ev is not None:   # BE3D: the directors follow the converged configuration
+                q, _, state = ev
+                m = model.bind(state)
     finally:
         if saved is not None:
             model.load_factor = saved
     return StaticResult(q=q, status=status, message=message,
                         iterations=sum(s["iterations"] for s in steps), steps=steps,
-                        stats=solver.stats, cpu_time=_time.process_time() - start)
+                        stats=solver.stats, cpu_time=_time.process_time() - start, state=state)

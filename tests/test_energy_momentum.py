@@ -2,13 +2,12 @@
 
 Beams of benchmarks B2/B3 revision 2 (L = 1 m, a = 0.05 m, E = 1e5, nu = 0.3, rho = 2500; B2: pulse
 force 0.24 N and moment 0.24 N m at B for 2.5 s; B3: hat moment (0.1, 0.05, 0.2) N m for 3 s), on
-small meshes. The stepper is driven by the protocol (initialize, step, accept) in a local loop.
+small meshes, run by ``simulate(..., method="energy-momentum")``.
 """
 import numpy as np
 import pytest
 
-from ancfdae import Material, PointForce, PointMoment, RectangularSection, hat, models, pulse
-from ancfdae.integrators._base import consistent_acceleration
+from ancfdae import Material, PointForce, PointMoment, RectangularSection, hat, models, pulse, simulate
 from ancfdae.integrators._discrete_gradient import AVFGradient, GonzalezGradient
 from ancfdae.integrators.energy_momentum import EnergyMomentum
 from ancfdae.monitors import EnergyMonitor
@@ -34,25 +33,11 @@ def b3(name, n, t_load=3.0, **kw):
                        loads=[PointMoment((0.1, 0.05, 0.2), node=0, time=hat(t_load / 2))])
 
 
-def march(model, h, t_end, monitor=None, every=None, **options):
-    """Protocol loop; returns the stepper and the states (t, q, v) after every step."""
-    I = EnergyMomentum(model, h, **options)
-    q, v = model.initial_state()
-    a, _ = consistent_acceleration(model, 0.0, q, v)
-    I.initialize(0.0, q, v, a, t_end)
-    if monitor is not None:
-        monitor.start(model, 0.0, q, v, a)
-        monitor.sample(0.0, q, v, a)
-    out = [(0.0, q, v)]
-    while I.t < t_end:
-        o = I.step()
-        assert o.ok, o.message
-        I.accept(o)
-        if monitor is not None:
-            monitor.advance(o.t, o.q, o.v, o.a, o.quadrature)
-            monitor.sample(o.t, o.q, o.v, o.a)
-        out.append((o.t, o.q, o.v))
-    return I, out
+def march(model, h, t_end, monitor=None, **options):
+    """``simulate(..., method="energy-momentum")``; returns the Result and the states (t, q, v) of every step."""
+    res = simulate(model, (0.0, t_end), "energy-momentum", h=h, monitors=[monitor] if monitor else (), **options)
+    assert res.success, res.message
+    return res, list(zip(res.t, res.q, res.v))
 
 
 def total_energy(model, states, t_from):
@@ -150,7 +135,7 @@ def test_free_motion_energy_constant_every_element(name, n, kw):
     I, states = march(beam, 1e-2, t_load + 250 * 1e-2)
     E = total_energy(beam, states, t_load)
     assert np.ptp(E) <= 1e-12 * np.abs(E).max(), np.ptp(E) / np.abs(E).max()
-    assert I.discrete_gradient == ("avf" if "continuum" in kw.get("formulation", "") and name.startswith("SQ")
+    assert I.options["discrete_gradient"] == ("avf" if "continuum" in kw.get("formulation", "") and name.startswith("SQ")
                                    else "gonzalez")
 
 
@@ -161,7 +146,7 @@ def test_linear_momentum_exact_under_pure_moment(dg):
     Catches: a correction or AVF node that is not translation-equivariant, a moment with a resultant.
     """
     beam = b3("SQ3D", 2, t_load=0.5, formulation="continuum")
-    I, states = march(beam, 1e-2, 1.5, discrete_gradient=dg)
+    _, states = march(beam, 1e-2, 1.5, discrete_gradient=dg)
     p, _ = momenta(beam, states)
     M = beam.mass(None)
     scale = np.abs(M @ states[-1][2]).sum()
@@ -190,9 +175,8 @@ def test_energy_balance_with_loads():
     Catches: non-conservative forces evaluated off the midpoint, a quadrature that is not the scheme's.
     """
     beam = b2("SQ2D", 2, T=0.5)
-    mon = EnergyMonitor()
-    march(beam, 5e-3, 0.5, monitor=mon)
-    log = mon.log()
+    res, _ = march(beam, 5e-3, 0.5, monitor=EnergyMonitor())
+    log = res.monitors["energy"]
     assert np.abs(log["work"]).max() > 1e-4          # the load does work
     assert np.abs(log["drift"]).max() <= 1e-12 * log["scale"], log["relative_drift"]
 
@@ -221,8 +205,14 @@ def test_bad_options():
         EnergyMomentum(beam, 1e-2, discrete_gradient="avf")
     with pytest.raises(ValueError, match="h"):
         EnergyMomentum(beam, -1.0)
-    with pytest.raises(ValueError, match="PotentialModel"):
-        EnergyMomentum(object(), 1e-2)
+    with pytest.raises(ValueError, match="'potential' capability"):
+        EnergyMomentum(SpringChainNoPotential(), 1e-2)
+
+
+class SpringChainNoPotential(SpringChain):
+    """Has the methods but does not declare them: the integrator must use nothing undeclared."""
+
+    capabilities = frozenset({"step_events"})
 
 
 def test_damped_model_refused():
@@ -232,3 +222,5 @@ def test_damped_model_refused():
     q, v = model.initial_state()
     with pytest.raises(ValueError, match="velocity-dependent"):
         I.initialize(0.0, q, v, np.zeros_like(q), 1.0)
+    res = simulate(model, (0.0, 1.0), "energy-momentum", h=1e-2)
+    assert not res.success and "velocity-dependent" in res.message

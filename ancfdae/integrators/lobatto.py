@@ -21,9 +21,10 @@ the band structure of the model's matrices, has the blocks::
 
     dr_i / dA_k = delta_ik M_i + h a_ik D_i + h^2 (a^2)_ik K_i
 
-with ``K_i, D_i, M_i`` the exact Jacobian blocks at stage ``i``. A model with the optional
-method ``residual_stages(ts, Q, V, A) -> R`` (columns = stages, e.g. :class:`~ancfdae.models.Beam`)
-has all implicit stages' residuals evaluated in one call; otherwise one ``residual`` call per stage.
+with ``K_i, D_i, M_i`` the exact Jacobian blocks at stage ``i``. A model that declares the
+capability ``"residual_stages"`` (:mod:`ancfdae.problem`; ``residual_stages(ts, Q, V, A) -> R``,
+columns = stages, e.g. :class:`~ancfdae.models.Beam`) has all implicit stages' residuals evaluated
+in one call; otherwise one ``residual`` call per stage.
 """
 from __future__ import annotations
 
@@ -34,6 +35,8 @@ import scipy.sparse as sp
 
 from ancfdae import _validate as V
 from ancfdae.integrators._base import FixedStepIntegrator
+from ancfdae.integrators.protocol import Quadrature
+from ancfdae.problem import capabilities
 
 __all__ = ["ButcherTableau", "LOBATTO_IIIA_2", "LOBATTO_IIIA_3", "LobattoIIIA"]
 
@@ -162,6 +165,7 @@ class LobattoIIIA(FixedStepIntegrator):
     def _init_impl(self):
         self._prev = None  # (h, stage accelerations (n, s)) of the last step
         self._w_cache = None
+        self._stages = "residual_stages" in capabilities(self.model)
 
     # -- predictor -------------------------------------------------------------------------
     def _guess(self, h):
@@ -239,7 +243,7 @@ class LobattoIIIA(FixedStepIntegrator):
                 self._set_floor(blk, qs)
                 return self._matrix([blk], h)
         else:
-            stages = getattr(self.model, "residual_stages", None)
+            stages = self.model.residual_stages if self._stages else None
 
             def residual(x):
                 X = x.reshape(n, m)
@@ -267,8 +271,8 @@ class LobattoIIIA(FixedStepIntegrator):
         Q, V_ = Q0 + X @ CQ, V0 + X @ CV
         if self.predictor == "extrapolate":
             self._prev = (h, np.column_stack([self.a, X]))
-        nodes = None
-        if self.want_nodes:  # the step's Lobatto quadrature, for monitors that integrate over it
-            nodes = (np.r_[t, ts], np.column_stack([self.q, Q]).T, np.column_stack([self.v, V_]).T,
-                     h * self.tableau.b)
-        return True, (Q[:, -1].copy(), V_[:, -1].copy(), X[:, -1].copy(), nodes)
+        quad = None
+        if self.want_quadrature:  # the step's Lobatto quadrature, for monitors that integrate over it
+            quad = Quadrature(np.r_[t, ts], np.column_stack([self.q, Q]).T, np.column_stack([self.v, V_]).T,
+                              h * self.tableau.b)
+        return True, (Q[:, -1].copy(), V_[:, -1].copy(), X[:, -1].copy(), quad)

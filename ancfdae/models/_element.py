@@ -194,11 +194,19 @@ class Element(ABC):
         """Kinetic energy beyond ``1/2 v^T M_const v``, shape (n_el,)."""
         return np.zeros(len(q))
 
-    def accept_step(self, geom, Q: np.ndarray, V: np.ndarray):
-        """Hook after an accepted time or load step (BE3D director update).
+    def event_state(self, geom) -> dict:
+        """The element's event state in ``geom`` (arrays that may change between steps); none by default."""
+        return {}
+
+    def bind(self, geom, state: dict) -> dict:
+        """A geometry equal to ``geom`` but with the event ``state`` (``geom`` is not changed)."""
+        return geom
+
+    def step_event(self, geom, Q: np.ndarray, V: np.ndarray):
+        """Event after an accepted time or load step (BE3D's director update); None = nothing changed.
 
         ``Q``, ``V``: full nodal coordinate and velocity arrays, shape
-        (n_nodes_global, n_node_dof). Returns the (possibly re-parametrised)
-        ``(Q, V)``; the physical configuration must not change.
+        (n_nodes_global, n_node_dof). Returns None or the (re-parametrised) ``(Q, V, state)``
+        with the new event state; the physical configuration must not change.
         """
-        return Q, V
+        return None

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._validate import choice, finite_vector, positive_int
-from ._be3d_dynamics import UPDATES, rotary_inertia, rotary_kinetic_energy, update_directors
+from ._be3d_dynamics import UPDATES, director_sines, rotary_inertia, rotary_kinetic_energy, update_directors
 from ._be3d_kinematics import curvature_energy, curvatures, director_field, frames, spin_gradient
 from ._element import Element
 from ._scalar_jet import Jet
@@ -63,8 +63,9 @@ class BE3D(Element):
     section : RectangularSection or CircularSection
         Uses ``A``, ``I2``, ``I3``, ``J = I2 + I3`` and ``k_t``.
     director_update : {"projected", "post-rotated", "none"}
-        Update of the nodal directors after each accepted step (Sect. 3.6),
-        done by :meth:`accept_step`. With ``"post-rotated"`` the update is
+        Update of the nodal directors after an accepted step (Sect. 3.6): a
+        model event (:meth:`step_event`); the directors are the beam's event
+        state, carried by the driver and kept in ``Result.model_state``. With ``"post-rotated"`` the update is
         also applied to the reference configuration (director ``e3``,
         ``theta = 0``), so that the values fixed by supports stay valid.
     director : array_like (3,), optional
@@ -73,6 +74,11 @@ class BE3D(Element):
     axial_points, bending_points, inertia_points : int
         Gauss points of the axial term, of the bending and torsion terms,
         and of the rotary kinetic energy.
+    update_below : float in (0, 1], optional
+        Update the directors only when at some node the sine of the angle
+        between director and axis (the norm of the projection of Eq. 99 of
+        the unit director) falls below this value; None (default) updates
+        after every step, as the chapter does.
     """
 
     name = "BE3D"
@@ -82,11 +88,16 @@ class BE3D(Element):
     mass_is_constant = False
 
     def __init__(self, material, section, director_update: str = "projected", director=None,
-                 axial_points: int = 5, bending_points: int = 3, inertia_points: int = 3):
+                 axial_points: int = 5, bending_points: int = 3, inertia_points: int = 3,
+                 update_below: float | None = None):
         check_material_section(material, section, ("A", "I2", "I3", "J", "k_t"))
         self.material = material
         self.section = section
         self.director_update = choice("director_update", director_update, UPDATES)
+        if update_below is not None and (isinstance(update_below, bool) or not isinstance(update_below, (int, float))
+                                         or not 0.0 < update_below <= 1.0):
+            raise ValueError(f"`update_below` must be None or a number in (0, 1], got {update_below!r}.")
+        self.update_below = None if update_below is None else float(update_below)
         if director is not None:
             director = finite_vector("director", director, 3)
             if not np.linalg.norm(director) > 0:
@@ -157,7 +168,9 @@ class BE3D(Element):
         self._pending = None
         if D is None or D.shape[0] != n_el + 1:
             D = self._fallback_directors(q_ref)
-        geom = {"L": lengths, "directors": np.array(D, dtype=float),
+        D = np.array(D, dtype=float)
+        D.setflags(write=False)   # event state: replaced (Beam.bind), never changed in place
+        geom = {"L": lengths, "directors": D,
                 "axial": PointRule(self.axial_points, lengths, _DOF, _NDOF),
                 "bend": self._rule(self.bending_points, lengths),
                 "inertia": self._rule(self.inertia_points, lengths),
@@ -297,10 +310,31 @@ class BE3D(Element):
         """``1/2 int rho J omega1^2 dxi`` per element."""
         return rotary_kinetic_energy(geom["inertia"], geom, q, v, self.rhoJ)
 
-    def accept_step(self, geom, Q, V):
-        """Director update of Sect. 3.6 (``director_update``); see :func:`._be3d_dynamics.update_directors`."""
-        return update_directors(geom, np.asarray(Q, dtype=float), np.asarray(V, dtype=float),
-                                self.director_update)
+    def event_state(self, geom) -> dict:
+        """``{"directors": (n_nodes, 3)}``: the nodal directors, carried by the driver between steps."""
+        return {"directors": geom["directors"]}
+
+    def bind(self, geom, state) -> dict:
+        """``geom`` with the nodal directors of ``state`` (read-only; ``geom`` itself is unchanged)."""
+        D = np.array(state["directors"], dtype=float)
+        if D.shape != geom["directors"].shape:
+            raise ValueError(f"`state['directors']` must have shape {geom['directors'].shape}, got {D.shape}.")
+        D.setflags(write=False)
+        return dict(geom, directors=D)
+
+    def step_event(self, geom, Q, V):
+        """Director update of Sect. 3.6 (``director_update``, ``update_below``); None when not done.
+
+        See :func:`._be3d_dynamics.update_directors`.
+        """
+        if self.director_update == "none":
+            return None
+        D = geom["directors"]
+        Q = np.asarray(Q, dtype=float)
+        if self.update_below is not None and np.min(director_sines(D, Q)) >= self.update_below:
+            return None
+        Q2, V2, D2 = update_directors(D, Q, np.asarray(V, dtype=float), self.director_update)
+        return Q2, V2, {"directors": D2}
 
 
 def _check_director(d, e1):
