@@ -205,8 +205,9 @@ class PotentialModel(Protocol):
     The residual splits as ``r = M a + dP/dq - f_nc(t, q)`` with a *constant* mass
     matrix, the conservative potential ``P = U + V`` (strain energy plus the
     potential of the conservative loads, i.e. gravity) and the non-conservative
-    loads ``f_nc`` (dead forces, moments). Optional: an integrator that needs it
-    checks for these members and raises a ValueError naming the missing one.
+    loads ``f_nc`` (dead forces, moments). Optional: a model offers it by declaring
+    the ``"potential"`` capability (:data:`CAPABILITIES`); ``symmetry_generators``
+    and ``potential_degree`` are optional within it.
 
     Attributes
     ----------
