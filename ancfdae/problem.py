@@ -1,4 +1,4 @@
-"""The contract between models and integrators (design.md Sect. 3).
+"""The contract between models and integrators.
 
 A *Model* is the semi-discrete equation of motion in residual form, with the
 boundary conditions already applied (fixed coordinates eliminated)::

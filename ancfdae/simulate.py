@@ -16,6 +16,7 @@ from ancfdae.integrators.energy_momentum import EnergyMomentum
 from ancfdae.integrators.ida import IDA
 from ancfdae.integrators.lobatto import LobattoIIIA
 from ancfdae.integrators.newmark import GeneralizedAlpha, HHTAlpha, Newmark
+from ancfdae._resultfile import describe_model
 from ancfdae.integrators.protocol import Integrator
 from ancfdae.result import Result
 
@@ -149,5 +150,8 @@ def simulate(model, t_span, method="lobatto3", h=None, t_eval=None, monitors=(),
         the failure.
     """
     stepper = _build(model, method, h, options)
-    return integrate(stepper, model, t_span, t_eval=t_eval, monitors=monitors, hooks=hooks, q0=q0, v0=v0,
-                     state0=state0, max_steps=max_steps, progress=bool(progress))
+    result = integrate(stepper, model, t_span, t_eval=t_eval, monitors=monitors, hooks=hooks, q0=q0, v0=v0,
+                       state0=state0, max_steps=max_steps, progress=bool(progress))
+    if not result.model:   # the model's self-description, for self-describing result files
+        result.model = describe_model(model)
+    return result

@@ -1,36 +1,339 @@
-"""Shared plumbing of the studies: output folder, progress, markdown tables, parallel sweeps."""
+"""Shared plumbing of the studies: output folder, the case runner that keeps every finished case, tables.
+
+A study is a sweep of independent cases (one simulation each). :func:`run_cases`
+runs them serially or through an executor, writes each finished case to the
+output folder as soon as it finishes (:class:`CaseStore`), reuses the cases a
+previous run with the same options left there, records a case that raises as
+that case's failure and goes on, and on Ctrl-C cancels the rest, stops its own
+worker processes and raises :class:`Interrupted` (the command line prints one
+line and exits 130).
+"""
 from __future__ import annotations
 
+import json
 import multiprocessing
 import os
+import re
+import signal
 import sys
 import time
-from concurrent.futures import Executor, ProcessPoolExecutor
+import traceback
+from concurrent.futures import FIRST_COMPLETED, Executor, ProcessPoolExecutor, wait
+from dataclasses import dataclass, field
 from pathlib import Path
 
-__all__ = ["output_dir", "Progress", "markdown_table", "run_cases", "command_line"]
+from ancfdae.result import Result
+
+__all__ = ["Case", "output_dir", "CaseStore", "Sweep", "Interrupted", "run_cases", "markdown_table", "progress_bar",
+           "settings"]
 
 
-def output_dir(name: str, out=None) -> Path:
-    """The study's output folder (created): ``out`` or ``./out/<name>``."""
-    path = Path(out) if out is not None else Path("out") / name
-    path.mkdir(parents=True, exist_ok=True)
+def output_dir(name: str, out=None, quick: bool = False) -> Path:
+    """The study's output folder, checked and created before any work.
+
+    Parameters
+    ----------
+    name : str
+        Study name.
+    out : path, optional
+        The folder; default ``out/NAME`` (``out/NAME-quick`` in quick mode,
+        so that a quick run never overwrites a full run's results).
+    quick : bool
+
+    Raises
+    ------
+    ValueError
+        If ``out`` is an existing file or cannot be created as a folder.
+    """
+    path = Path(out) if out is not None else Path("out") / (f"{name}-quick" if quick else name)
+    if path.exists() and not path.is_dir():
+        raise ValueError(f"`out` must be a folder, got {str(path)!r}, which is an existing file.")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ValueError(f"`out` must be a folder that can be created, got {str(path)!r}: {exc}") from None
+    if not os.access(path, os.W_OK):
+        raise ValueError(f"`out` must be a writable folder, got {str(path)!r}.")
     return path
 
 
-class Progress:
-    """Prints one line per finished case with the elapsed time (to stderr; silent if disabled)."""
+class Case(dict):
+    """A sweep case: a dict of options whose ``str`` is its ``label`` (progress line, stored file names)."""
 
-    def __init__(self, name: str, total: int, enabled: bool = True):
-        self.name, self.total, self.enabled = name, total, enabled
-        self.done = 0
-        self.start = time.perf_counter()
+    def __str__(self):
+        return str(self.get("label", dict.__repr__(self)))
 
-    def __call__(self, message: str) -> None:
-        self.done += 1
-        if self.enabled:
-            print(f"[{self.name} {self.done}/{self.total} {time.perf_counter() - self.start:7.1f}s] {message}",
-                  file=sys.stderr, flush=True)
+
+def _jsonable(obj):
+    """Plain Python (lists, floats, ...) of ``obj`` for JSON; numpy scalars and arrays converted."""
+    if isinstance(obj, dict):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    if hasattr(obj, "tolist"):
+        return obj.tolist()
+    return obj
+
+
+def _key(label: str) -> str:
+    """A file name from a case label ("BE2D 8 el (reference)" -> "BE2D_8_el_reference")."""
+    return re.sub(r"[^A-Za-z0-9.+-]+", "_", label).strip("_")
+
+
+class CaseStore:
+    """The finished cases of a study in ``folder/cases``.
+
+    Per case two files: the simulation's :class:`ancfdae.Result`, written by
+    :meth:`Result.save` (self-describing; its format is the library's), and
+    ``KEY.json`` with the case's options, its scalars (CPU time, counters, ...)
+    and the name of the Result file. The JSON is written last and atomically,
+    so a case counts as finished only once both files are complete. A case
+    whose function raised is kept as ``KEY.json`` with ``"error"``; it is run
+    again on the next run.
+    """
+
+    def __init__(self, folder):
+        self.folder = Path(folder) / "cases"
+        self.folder.mkdir(parents=True, exist_ok=True)
+
+    def _json(self, case) -> Path:
+        return self.folder / (_key(str(case)) + ".json")
+
+    def load(self, case):
+        """The stored record of ``case`` (a dict with ``"result"``), or None if absent, failed or stale."""
+        path = self._json(case)
+        if not path.is_file():
+            return None
+        try:
+            meta = json.loads(path.read_text())
+        except (OSError, ValueError):
+            return None
+        if meta.get("case") != _jsonable(dict(case)) or "error" in meta:
+            return None        # other options (or a failure): run it again
+        try:
+            result = Result.load(self.folder / meta["file"])
+        except (OSError, ValueError, KeyError):
+            return None
+        return dict(meta["record"], result=result)
+
+    def save(self, case, record: dict) -> Path:
+        """Write ``record`` (``"result"``: a Result; other entries JSON-able scalars) of ``case``."""
+        stem = _key(str(case))
+        file = record["result"].save(self.folder / stem)
+        scalars = {k: v for k, v in record.items() if k != "result"}
+        return self._write(case, {"case": _jsonable(dict(case)), "file": Path(file).name,
+                                  "record": _jsonable(scalars)})
+
+    def save_error(self, case, error: str) -> Path:
+        """Record that ``case`` raised (``error``: the exception's text)."""
+        return self._write(case, {"case": _jsonable(dict(case)), "error": error})
+
+    def _write(self, case, meta) -> Path:
+        path = self._json(case)
+        tmp = path.with_name(path.name + ".tmp")
+        tmp.write_text(json.dumps(meta, indent=1, allow_nan=True))
+        os.replace(tmp, path)
+        return path
+
+
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C during a sweep: the finished cases are kept; ``str()`` says how many and where."""
+
+
+@dataclass
+class Sweep:
+    """What :func:`run_cases` returns.
+
+    Attributes
+    ----------
+    records : list
+        Per case in the order of the cases: its record (after ``reduce``), or
+        None if it raised.
+    errors : dict
+        ``{label: error text}`` of the cases that raised.
+    reused : int
+        Cases taken from the output folder instead of being run.
+    """
+
+    records: list
+    errors: dict = field(default_factory=dict)
+    reused: int = 0
+
+    def finished(self) -> list:
+        """The records of the cases that did not raise."""
+        return [r for r in self.records if r is not None]
+
+
+def progress_bar(name: str, total: float, initial: float = 0, enabled: bool = True):
+    """A tqdm bar on stderr: share of the work done, elapsed time, estimated time left, cases done and the last."""
+    from tqdm import tqdm
+    return tqdm(total=total, initial=initial, desc=name, file=sys.stderr, disable=not enabled, dynamic_ncols=True,
+                bar_format="{desc} {percentage:3.0f}% [{elapsed}<{remaining}] {postfix}")
+
+
+def _ignore_sigint():
+    # Worker processes leave Ctrl-C to the parent, which cancels the sweep and stops them:
+    # no traceback from every worker, and no worker dying half-way through writing a pipe.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _error_text(exc: BaseException) -> str:
+    """``Type: message (at file:line in function)`` -- where the innermost frame of the case raised."""
+    text = "".join(traceback.format_exception_only(type(exc), exc)).strip()
+    frames = traceback.extract_tb(exc.__traceback__) if exc.__traceback__ is not None else []
+    remote = getattr(exc.__cause__, "tb", None)            # a worker's traceback, as text
+    if frames and not remote:
+        f = frames[-1]
+        text += f" (at {Path(f.filename).name}:{f.lineno} in {f.name})"
+    elif remote:
+        lines = [ln.strip() for ln in str(remote).splitlines() if ln.strip().startswith("File ")]
+        if lines:
+            text += f" (at {lines[-1]})"
+    return text
+
+
+def run_cases(fn, cases, out=None, executor: Executor | None = None, jobs: int | None = None, reduce=None,
+              name: str = "study", progress: bool = True, cost=None) -> Sweep:
+    """Run ``fn`` over ``cases``, keeping each finished case in ``out``.
+
+    Parameters
+    ----------
+    fn : callable
+        A module-level function (picklable) taking one case and returning a
+        record: a dict with ``"result"`` (an :class:`ancfdae.Result`) and
+        JSON-able scalars.
+    cases : list of dict
+        Each case's ``str`` is its label (unique within the sweep; it names
+        the stored files).
+    out : path, optional
+        Output folder: finished cases are written to ``out/cases`` as they
+        finish, and cases stored there by an earlier run with the same
+        options are reused. None: nothing is written.
+    executor : concurrent.futures.Executor, optional
+        Any executor -- e.g. a Dask ``distributed.Client().get_executor()``;
+        it is not shut down here (on Ctrl-C its pending futures are cancelled).
+    jobs : int, optional
+        Without an executor: ``1`` (default) runs serially in this process
+        (timings undisturbed); more starts a local process pool of that size,
+        whose workers are stopped on Ctrl-C.
+    reduce : callable, optional
+        Applied to each record once stored (e.g. to drop the full coordinate
+        history and keep what the analysis needs).
+    name : str
+        Shown by the progress bar.
+    progress : bool
+        Show a progress bar with elapsed time and the estimated time left,
+        advancing in completion order.
+    cost : callable, optional
+        Relative cost of a case (``cost(case) -> float``); the progress bar
+        advances by it, so that its estimate of the time left holds when the
+        cases differ in cost (default: equal).
+
+    Returns
+    -------
+    Sweep
+
+    Raises
+    ------
+    Interrupted
+        On Ctrl-C, after the pending cases are cancelled and the own workers
+        stopped; finished cases are kept in ``out``.
+    """
+    cases = list(cases)
+    labels = [str(c) for c in cases]
+    if len(set(labels)) != len(labels):
+        raise ValueError(f"`cases` must have unique labels, got duplicates in {labels}.")
+    store = CaseStore(out) if out is not None else None
+    reduce = reduce or (lambda r: r)
+    records = [None] * len(cases)
+    todo = []
+    for i, case in enumerate(cases):
+        rec = store.load(case) if store is not None else None
+        if rec is None:
+            todo.append(i)
+        else:
+            records[i] = reduce(rec)
+    sweep = Sweep(records, reused=len(cases) - len(todo))
+    if sweep.reused and progress:
+        print(f"{name}: reusing {sweep.reused} of {len(cases)} finished cases from {store.folder}",
+              file=sys.stderr, flush=True)
+    weight = [float(cost(c)) if cost is not None else 1.0 for c in cases]
+    bar = progress_bar(name, sum(weight), sum(w for w, r in zip(weight, records) if r is not None), progress)
+    count = [sweep.reused]
+
+    def finish(i, record=None, exc=None):
+        if exc is not None:
+            sweep.errors[labels[i]] = _error_text(exc)
+            if store is not None:
+                store.save_error(cases[i], sweep.errors[labels[i]])
+            bar.write(f"{name}: case {labels[i]!r} raised {sweep.errors[labels[i]]}; the others go on",
+                      file=sys.stderr)
+        else:
+            if store is not None:
+                store.save(cases[i], record)
+            records[i] = reduce(record)
+        count[0] += 1
+        bar.set_postfix_str(f"{count[0]}/{len(cases)} cases, last: {labels[i]}", refresh=False)
+        bar.update(weight[i])
+
+    pool = None
+    try:
+        if executor is None and (jobs is None or jobs <= 1):
+            for i in todo:
+                try:
+                    record = fn(cases[i])
+                except Exception as exc:        # one case's failure, recorded; KeyboardInterrupt passes
+                    finish(i, exc=exc)
+                else:
+                    finish(i, record)
+        elif todo:
+            if executor is None:
+                # "spawn": forking a process that already runs threads (OpenMP, numba, SUNDIALS -- e.g.
+                # inside a test session) can deadlock the children; fresh interpreters cost ~1 s each.
+                pool = executor = ProcessPoolExecutor(max_workers=jobs, initializer=_ignore_sigint,
+                                                      mp_context=multiprocessing.get_context("spawn"))
+            pending = {executor.submit(fn, cases[i]): i for i in todo}
+            try:
+                while pending:
+                    done, _ = wait(pending, return_when=FIRST_COMPLETED)
+                    for fut in done:
+                        i = pending.pop(fut)
+                        exc = fut.exception()
+                        if exc is not None:
+                            finish(i, exc=exc)
+                        else:
+                            finish(i, fut.result())
+            except BaseException:
+                for fut in pending:
+                    fut.cancel()
+                raise
+    except KeyboardInterrupt:
+        _stop(pool)
+        pool = None
+        bar.close()
+        n_done = sum(r is not None for r in records)
+        where = f" in {store.folder}" if store is not None else " (no output folder: not kept)"
+        raise Interrupted(f"{name} interrupted: {n_done} of {len(cases)} cases finished and kept{where}; "
+                          "run the same command again to continue.") from None
+    finally:
+        if pool is not None:
+            pool.shutdown()
+    bar.close()
+    return sweep
+
+
+def _stop(pool) -> None:
+    """Stop an own process pool now: cancel what is queued, terminate the workers."""
+    if pool is None:
+        return
+    procs = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for p in procs:
+        if p.is_alive():
+            p.terminate()
+    deadline = time.monotonic() + 5.0
+    for p in procs:
+        p.join(timeout=max(0.0, deadline - time.monotonic()))
 
 
 def markdown_table(headers, rows) -> str:
@@ -44,62 +347,13 @@ def markdown_table(headers, rows) -> str:
     return "\n".join(lines) + "\n"
 
 
-def run_cases(fn, cases, executor: Executor | None = None, jobs: int | None = None, progress=None):
-    """Map ``fn`` over ``cases`` through the standard executor interface.
+def settings(full: dict, quick_defaults: dict, quick: bool, given: dict) -> dict:
+    """A study's options: the full (or, with ``quick``, the quick) defaults overridden by ``given``.
 
-    Parameters
-    ----------
-    fn : callable
-        A module-level function (picklable) taking one case.
-    cases : list
-    executor : concurrent.futures.Executor, optional
-        Any executor -- e.g. a ``ProcessPoolExecutor`` or a Dask
-        ``distributed.Client().get_executor()``; it is not shut down here.
-    jobs : int, optional
-        Without an executor: ``1`` runs serially in this process (timings
-        undisturbed); more starts a local process pool of that size.
-    progress : callable, optional
-        Called with a short text per finished case.
-
-    Returns
-    -------
-    list
-        Results in the order of ``cases``.
+    ``given`` holds the ``run`` arguments; None means "the mode's default".
     """
-    if executor is None and (jobs is None or jobs <= 1):
-        out = []
-        for case in cases:
-            out.append(fn(case))
-            if progress:
-                progress(str(case))
-        return out
-    own = executor is None
-    if own:
-        # "spawn": forking a process that already runs threads (OpenMP, numba, SUNDIALS -- e.g. inside a
-        # test session) can deadlock the children; fresh interpreters cost ~1 s each.
-        executor = ProcessPoolExecutor(max_workers=jobs or os.cpu_count(),
-                                       mp_context=multiprocessing.get_context("spawn"))
-    try:
-        futures = [executor.submit(fn, case) for case in cases]
-        results = []
-        for case, fut in zip(cases, futures):
-            results.append(fut.result())
-            if progress:
-                progress(str(case))
-        return results
-    finally:
-        if own:
-            executor.shutdown()
-
-
-def command_line(run, doc: str, argv=None) -> None:
-    """``python -m ancfdae.studies.NAME [--quick] [--out DIR] [--jobs N]``: run a study and print its table."""
-    import argparse
-    p = argparse.ArgumentParser(description=doc.strip().splitlines()[0])
-    p.add_argument("--quick", action="store_true", help="small, fast version (what the tests run)")
-    p.add_argument("--out", default=None, help="output folder (default out/NAME)")
-    p.add_argument("--jobs", type=int, default=None, help="worker processes for the sweep")
-    args = p.parse_args(argv)
-    res = run(quick=args.quick, out=args.out, jobs=args.jobs)
-    print(res["table"])
-    print(f"written to {res['path']}")
+    base = dict(full, **quick_defaults) if quick else dict(full)
+    unknown = [k for k in given if k not in base]
+    if unknown:
+        raise TypeError(f"unknown study options {unknown}; known: {sorted(base)}")
+    return {k: (given[k] if given.get(k) is not None else v) for k, v in base.items()}

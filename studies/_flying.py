@@ -4,15 +4,20 @@ Both beams (benchmarks.md): L = 1 m, square section a = 0.05 m, E = 1e5 N/m^2,
 nu = 0.3, rho = 2500 kg/m^3 (chapter Eq. 114), free-free, straight and at
 rest along ``r(s) = s (0.6, 0.8[, 0])``; B is the end s = 0.
 
-* B2 (in plane): dead force ``f(t) (0.8, 0) N`` and moment ``f(t) 0.8 N m``
-  about +e_z at B, pulse ``f(t) = (1 - cos(2 pi t / T_p)) / 2`` for
-  ``t <= T_p = 2.5 s``, 0 after.
-* B3 (in space): dead moment ``f(t) (0.4, 0.2, 0.8) N m`` at B with the hat
-  ``f(t) = t/1.5`` up to 1.5 s, down to 0 at 3 s.
+* B2 (in plane, revision 2): dead force ``f(t) (0.24, 0) N`` and moment
+  ``f(t) 0.24 N m`` about +e_z at B, pulse ``f(t) = (1 - cos(2 pi t / T_p)) / 2``
+  for ``t <= T_p = 2.5 s``, 0 after. (Revision 1 had 0.8 N and 0.8 N m,
+  M L / EI = 15: that motion is chaotic after about 6 s, and eps_T over
+  [0, 10] s then converges at order 0.5-0.8 whatever the step.)
+* B3 (in space, revision 2): dead moment ``f(t) (0.1, 0.05, 0.2) N m`` at B
+  with the hat ``f(t) = t/1.5`` up to 1.5 s, down to 0 at 3 s. (Revision 1
+  had four times that moment: the beam spun about its axis at up to
+  284 rad/s and BE3D failed within 1.2-2.3 s on every mesh.)
 
-:func:`simulate_case` runs one case and returns a small picklable dict
-(tip history, energy log, work counters, CPU time), so that sweeps can run in
-worker processes (:func:`studies._common.run_cases`). :func:`eps_T` is the
+:func:`simulate_case` runs one case and returns a record
+(the :class:`ancfdae.Result` with the tip and energy monitors, CPU time), which
+the runner (:func:`studies._common.run_cases`) stores as soon as the case
+finishes; :func:`unpack` turns it into the arrays the analyses use. :func:`eps_T` is the
 integrated tip error of chapter Eq. 115.
 """
 from __future__ import annotations
@@ -27,25 +32,24 @@ from ancfdae.integrators import NewtonOptions
 from ancfdae.monitors import EnergyMonitor, PointSensor
 from ancfdae.simulate import simulate
 
-__all__ = ["Case", "MATERIAL", "SECTION", "LENGTH", "T_PULSE", "T_HAT", "FAMILY", "available", "b2_beam", "b3_beam",
-           "simulate_case", "eps_T", "regress_order", "steady_drift"]
+from ._common import Case
+
+__all__ = ["Case", "MATERIAL", "SECTION", "LENGTH", "T_PULSE", "T_HAT", "B2_FORCE", "B2_MOMENT", "B3_MOMENT", "FAMILY",
+           "available", "b2_beam", "b3_beam",
+           "output_times", "simulate_case", "unpack", "eps_T", "regress_order", "steady_drift"]
 
 MATERIAL = Material(E=1e5, nu=0.3, rho=2500.0)
 SECTION = RectangularSection(0.05)
 LENGTH = 1.0
 T_PULSE = 2.5      # B2: end of the load pulse (s)
 T_HAT = 3.0        # B3: end of the moment hat (s)
+B2_FORCE = 0.24    # B2: peak force (N, global x), revision 2
+B2_MOMENT = 0.24   # B2: peak moment (N m, about +e_z), revision 2
+B3_MOMENT = (0.1, 0.05, 0.2)   # B3: peak moment (N m, global axes), revision 2
 
 #: element type -> family whose 128-element solution is the reference (chapter Sect. 5.2:
 #: "different for thin and for shear deformable beams").
 FAMILY = {"BE2D": "BE", "BE3D": "BE", "SQ2D": "SQ", "SQ3D": "SQ"}
-
-
-class Case(dict):
-    """A sweep case: a dict of options whose ``str`` is its ``label`` (shown by the progress line)."""
-
-    def __str__(self):
-        return str(self.get("label", dict.__repr__(self)))
 
 
 def available(names) -> list[str]:
@@ -69,9 +73,10 @@ def b2_beam(name: str, n_elements: int, E_scale: float = 1.0, **element_options)
     el = _element(name, E_scale, **element_options)
     f = pulse(T_PULSE)
     if el.dim == 2:
-        kw, F, M = dict(start=(0.0, 0.0), direction=(0.6, 0.8)), (0.8, 0.0), 0.8
+        kw, F, M = dict(start=(0.0, 0.0), direction=(0.6, 0.8)), (B2_FORCE, 0.0), B2_MOMENT
     else:
-        kw, F, M = dict(start=(0.0, 0.0, 0.0), direction=(0.6, 0.8, 0.0)), (0.8, 0.0, 0.0), (0.0, 0.0, 0.8)
+        kw, F, M = (dict(start=(0.0, 0.0, 0.0), direction=(0.6, 0.8, 0.0)), (B2_FORCE, 0.0, 0.0),
+                    (0.0, 0.0, B2_MOMENT))
     return models.Beam(el, n_elements, LENGTH, loads=[PointForce(F, node=0, time=f), PointMoment(M, node=0, time=f)],
                        **kw)
 
@@ -85,15 +90,32 @@ def b3_beam(name: str, n_elements: int, t_load: float = T_HAT, scale: float = 1.
     el = _element(name, **element_options)
     if el.dim != 3:
         raise ValueError(f"`element` of B3 must be a spatial type, got {name!r}.")
-    moment = scale * np.array([0.4, 0.2, 0.8])
+    moment = scale * np.array(B3_MOMENT)
     return models.Beam(el, n_elements, LENGTH, start=(0.0, 0.0, 0.0), direction=(0.6, 0.8, 0.0),
                        loads=[PointMoment(moment, node=0, time=hat(t_load / 2))])
+
+
+def output_times(t_end: float, dt_out: float) -> np.ndarray:
+    """Output grid ``0, dt_out, 2 dt_out, ...`` that ends exactly at ``t_end`` and never passes it.
+
+    ``k * dt_out`` in floating point can exceed ``t_end`` by an ulp (e.g.
+    ``140 * 0.01 > 1.4``), which the integrators reject; the last sample is
+    clamped to ``t_end``, and ``t_end`` is appended if it is not a multiple.
+    """
+    if not (t_end > 0 and dt_out > 0):
+        raise ValueError(f"`t_end` and `dt_out` must be positive, got {t_end!r} and {dt_out!r}.")
+    n = int(np.floor(t_end / dt_out + 1e-9))
+    t = np.arange(n + 1) * dt_out
+    t[-1] = min(t[-1], t_end)
+    if t_end - t[-1] > 1e-9 * dt_out:
+        t = np.append(t, t_end)
+    return t
 
 
 def simulate_case(beam, t_end: float, method: str = "lobatto3", h: float | None = 1e-3, dt_out: float = 0.01,
                   newton: dict | None = None, energy: bool = True, stop_on_blowup: bool = False,
                   **options) -> dict:
-    """Integrate ``beam`` over ``[0, t_end]``; return a compact record of the run.
+    """Integrate ``beam`` over ``[0, t_end]``; return the run's record.
 
     Parameters
     ----------
@@ -115,14 +137,12 @@ def simulate_case(beam, t_end: float, method: str = "lobatto3", h: float | None 
     Returns
     -------
     dict
-        ``t``, ``tip`` (position of B, (n_out, dim)), ``energy`` (dict of
-        arrays ``kinetic``, ``strain``, ``work``, ``total``, ``balance``) or
-        None, ``stats``, ``cpu`` (process seconds), ``wall``, ``status``,
-        ``message``, ``t_fail``, ``dof``.
+        ``result`` (the :class:`ancfdae.Result`, monitors ``tip`` and
+        ``energy``), ``cpu`` (process seconds), ``wall``, ``dof``: what the
+        study's runner stores per case; :func:`unpack` gives the arrays the
+        analyses use.
     """
-    n_out = int(round(t_end / dt_out))
-    t_eval = np.linspace(0.0, n_out * dt_out, n_out + 1)
-    t_eval = t_eval[t_eval <= t_end * (1 + 1e-12)]
+    t_eval = output_times(t_end, dt_out)
     monitors = [PointSensor(s=0.0, name="tip")]
     if energy:
         monitors.append(EnergyMonitor(stop_on_blowup=stop_on_blowup))
@@ -131,14 +151,26 @@ def simulate_case(beam, t_end: float, method: str = "lobatto3", h: float | None 
     c0, w0 = time.process_time(), time.perf_counter()
     res = simulate(beam, (0.0, t_end), method=method, h=h, t_eval=t_eval, monitors=monitors, **options)
     cpu, wall = time.process_time() - c0, time.perf_counter() - w0
+    return {"result": res, "cpu": cpu, "wall": wall, "dof": int(beam.n_dof)}
+
+
+def unpack(record: dict) -> dict:
+    """The analysis view of a stored record: the other entries plus ``t``, ``tip``, ``energy``, ``stats``,
+    ``status``, ``message``, ``t_fail`` from its Result (the coordinate history is dropped)."""
+    res = record["result"]
+    out = {k: v for k, v in record.items() if k != "result"}
     en = None
-    if energy:
+    if "energy" in res.monitors:
         log = res.monitors["energy"]
         en = {k: np.asarray(log[k]) for k in ("kinetic", "strain", "work", "total", "balance")}
-        en["t_blow_up"] = log["t_blow_up"]
-    return {"t": res.t.copy(), "tip": np.asarray(res.monitors["tip"]["position"]), "energy": en,
-            "stats": dict(res.stats), "cpu": cpu, "wall": wall, "status": res.status, "message": res.message,
-            "t_fail": res.t_fail, "dof": int(beam.n_dof)}
+        t_blow = log.get("t_blow_up")
+        # None when no blow-up; a file format without null may give NaN back
+        en["t_blow_up"] = None if t_blow is None or not np.isfinite(t_blow) else float(t_blow)
+    out.update(t=res.t, tip=np.asarray(res.monitors["tip"]["position"]).reshape(res.t.size, -1), energy=en,
+               stats=dict(res.stats), status=res.status, message=res.message, t_fail=res.t_fail,
+               options=dict(res.options),
+               monitors={k: v for k, v in res.monitors.items() if k not in ("tip", "energy")})
+    return out
 
 
 def eps_T(t, tip, t_ref, tip_ref) -> float:

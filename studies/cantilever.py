@@ -8,7 +8,7 @@ reports DOF, the tip error against chapter Eq. 113, CPU seconds and Newton
 iterations beside the chapter's own values, and plots Fig. 5 (error against
 elements and DOF) and Fig. 6 (CPU time against error).
 
-Run: ``ancfdae study cantilever [--quick] [--out DIR]``.
+Run: ``ancfdae study cantilever [--quick] [--out DIR] [--elements ...] [--n-elements ...]``.
 """
 from __future__ import annotations
 
@@ -19,9 +19,13 @@ import numpy as np
 from ancfdae import Material, PointForce, RectangularSection, solve_static
 from ancfdae import models
 
-from ._common import Progress, markdown_table, output_dir
+from ancfdae.result import Result
 
-__all__ = ["run", "build", "ELEMENTS", "TABLE2", "REFERENCE"]
+from ._cli import Option
+from ._common import Case, markdown_table, output_dir, run_cases, settings
+
+__all__ = ["run", "run_case", "build", "solve_case", "ELEMENTS", "TABLE2", "REFERENCE", "FULL", "QUICK",
+           "CLI_OPTIONS"]
 
 L = 2.0
 MATERIAL = Material(E=2.07e11, nu=0.3, rho=7800.0)
@@ -53,6 +57,17 @@ TABLE2 = {
 }
 
 
+#: defaults of the full study (chapter Table 2: 1 ... 64 elements); None: every available type
+FULL = dict(elements=None, n_elements=(1, 2, 4, 8, 16, 32, 64), repeats=3)
+#: quick mode (the tests)
+QUICK = dict(n_elements=(1, 2, 4, 8, 16), repeats=1)
+CLI_OPTIONS = [
+    Option("elements", str, "element types (none given: every available type)", nargs="+"),
+    Option("n_elements", int, "meshes", nargs="+"),
+    Option("repeats", int, "solves per case for the median CPU time"),
+]
+
+
 def available_elements() -> list[str]:
     """Element types of the study that ancfdae.models provides."""
     return [name for name in ELEMENTS if hasattr(models, name)]
@@ -72,9 +87,10 @@ def build(name: str, n_elements: int, **element_options):
 
 
 def solve_case(name: str, n_elements: int, repeats: int = 1, **element_options) -> dict:
-    """Solve B1 for one element type and mesh; CPU time is the median over ``repeats`` solves."""
+    """Solve B1 for one element type and mesh; CPU time: the median of ``repeats`` solves after an untimed one."""
     beam = build(name, n_elements, **element_options)
     cpu, wall = [], []
+    solve_static(beam, load_steps=10, tol=1e-8)      # untimed: compiled kernels and caches warm
     for _ in range(repeats):
         c0, w0 = time.process_time(), time.perf_counter()
         res = solve_static(beam, load_steps=10, tol=1e-8)
@@ -84,83 +100,124 @@ def solve_case(name: str, n_elements: int, repeats: int = 1, **element_options) 
     error = float(np.linalg.norm(tip - REFERENCE[ELEMENTS[name]]))
     return {"element": name, "n_elements": n_elements, "dof": int(beam.q_ref.size), "error": error,
             "tip": tip.tolist(), "cpu": float(np.median(cpu)), "wall": float(np.median(wall)),
-            "iterations": res.iterations, "status": res.status, "message": res.message}
+            "iterations": res.iterations, "status": res.status, "message": res.message,
+            "load_steps": [{"q": s["q"]} for s in res.steps], "load_factors": [s["load_factor"] for s in res.steps]}
 
 
-def _plots(rows, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+def _plots(rows, orders, path) -> dict:
+    """Figs. 5 and 6 with the chapter's Table 2 values beside ours; returns ``{file stem: Figure}``."""
+    from ._flying_plots import figure, order_guide, save, style
 
     names = list(dict.fromkeys(r["element"] for r in rows))
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    chapter_kw = dict(ls="none", marker="x", ms=7, mew=1.2)
+    fig, axes = figure(1, 2, figsize=(12, 4.6))
     for name in names:
         rs = [r for r in rows if r["element"] == name]
-        axes[0].loglog([r["n_elements"] for r in rs], [r["error"] for r in rs], "o-", label=name)
-        axes[1].loglog([r["dof"] for r in rs], [r["error"] for r in rs], "o-", label=name)
-    n = np.array([4, 64])
-    axes[0].loglog(n, 2e-3 * (n / 4.0) ** -4, "k--", label="order 4")
+        axes[0].loglog([r["n_elements"] for r in rs], [r["error"] for r in rs], label=name, **style(name))
+        axes[1].loglog([r["dof"] for r in rs], [r["error"] for r in rs], label=name, **style(name))
+        ch = TABLE2.get(name)
+        if ch and name.endswith("2D"):        # the chapter's 3D errors equal its 2D ones: drawn once
+            meshes = sorted(ch)
+            twin = name.replace("2D", "3D")
+            lab = f"chapter Table 2, {name}" + (f" (= {twin})" if twin in TABLE2 else "")
+            axes[0].loglog(meshes, [ch[m][1] for m in meshes], color=style(name)["color"], label=lab, **chapter_kw)
+        if ch:
+            meshes = sorted(ch)
+            axes[1].loglog([ch[m][0] for m in meshes], [ch[m][1] for m in meshes], color=style(name)["color"],
+                           label=f"chapter Table 2, {name}", **dict(chapter_kw, marker="x" if name.endswith("2D")
+                                                                   else "+"))
+        if name in orders and name.endswith("2D"):
+            fit = [r for r in rs if r["n_elements"] >= 4]
+            order_guide(axes[0], [r["n_elements"] for r in fit], [r["error"] for r in fit], orders[name],
+                        style(name)["color"], f"{name} ")
     axes[0].set(xlabel="number of elements", ylabel="tip error |u_ref - u_FE| (m)")
     axes[1].set(xlabel="degrees of freedom", ylabel="tip error (m)")
     for ax in axes:
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend()
-    fig.suptitle("B1 largely deforming cantilever: convergence (chapter Fig. 5)")
-    fig.tight_layout()
-    fig.savefig(path / "fig5_convergence.png", dpi=120)
-    plt.close(fig)
-    fig, ax = plt.subplots(figsize=(5.5, 4))
+        ax.legend(fontsize=7, loc="lower left")
+    fig.suptitle("B1 largely deforming cantilever: convergence (chapter Fig. 5); 3D types open markers, "
+                 "chapter values x / +")
+    figs = {"fig5_convergence": fig}
+
+    fig, ax = figure(figsize=(8.5, 4.6))
     for name in names:
         rs = [r for r in rows if r["element"] == name]
-        ax.loglog([r["error"] for r in rs], [r["cpu"] for r in rs], "o-", label=name)
+        ax.loglog([r["error"] for r in rs], [r["cpu"] for r in rs], label=f"{name} (ancfdae)", **style(name))
+        ch = TABLE2.get(name)
+        if ch:
+            meshes = sorted(ch)
+            ax.loglog([ch[m][1] for m in meshes], [ch[m][2] for m in meshes], color=style(name)["color"],
+                      ls=":", lw=0.8, marker="x" if name.endswith("2D") else "+", ms=7,
+                      label=f"{name} (chapter, HOTINT, 2013 hardware)")
     ax.set(xlabel="tip error (m)", ylabel="CPU time per 10-step solve (s)",
            title="B1: CPU time against error (chapter Fig. 6)")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(path / "fig6_performance.png", dpi=120)
-    plt.close(fig)
+    fig.legend(loc="outside right upper", fontsize=7)      # beside the axes: it covers no point
+    figs["fig6_performance"] = fig
+    for stem, f in figs.items():
+        save(f, path, stem)
+    return figs
 
 
-def run(elements=None, n_elements=(1, 2, 4, 8, 16, 32, 64), quick: bool = False, repeats: int = 3,
-        out=None, plots: bool = True, progress: bool = True) -> dict:
-    """Run the study.
+def run_case(case: dict) -> dict:
+    """One B1 solve (``case = {element, n, repeats}``) as a record for the runner.
+
+    The stored :class:`ancfdae.Result` holds the load path: ``t`` is the load
+    factor of each of the 10 steps and ``q`` the converged coordinates there.
+    """
+    row = solve_case(case["element"], case["n"], case["repeats"])
+    q = np.array([s["q"] for s in row.pop("load_steps")])
+    lam = np.array(row.pop("load_factors"), dtype=float)
+    zeros = np.zeros_like(q)
+    result = Result(t=lam, q=q, v=zeros, a=zeros, status="success" if row["status"] == "converged" else "failed",
+                    message=row["message"], stats={"newton_iterations": row["iterations"]}, method="static-newton",
+                    options={"load_steps": 10, "tol": 1e-8})
+    return dict(row, result=result)
+
+
+def run(elements=None, n_elements=None, repeats=None, quick: bool = False, out=None, plots: bool = True,
+        progress: bool = True) -> dict:
+    """Run the study. Every option left None takes its value from :data:`FULL` (:data:`QUICK` with ``quick``).
 
     Parameters
     ----------
-    elements : sequence of str, optional
+    elements : sequence of str
         Element types (default: every type available).
     n_elements : sequence of int
-        Meshes; ``quick`` uses 1 ... 16.
+        Meshes (chapter: 1 ... 64; quick: 1 ... 16).
+    repeats : int
+        Solves per case for the median CPU time (quick: 1).
     quick : bool
         Small meshes and one repeat: the test-suite mode.
-    repeats : int
-        Solves per case for the median CPU time.
     out : path, optional
-        Output folder (default ``out/cantilever``); ``None`` with
-        ``plots=False`` writes nothing.
+        Output folder (default ``out/cantilever``, ``out/cantilever-quick``
+        with ``quick``); checked before any work; each solved case is stored
+        there and reused by a rerun. ``None`` with ``plots=False`` writes
+        nothing.
     plots : bool
-        Write the markdown table and the PNG figures.
+        Write the markdown table and the figures (PNG and SVG).
+    progress : bool
+        Progress bar on stderr.
 
     Returns
     -------
     dict
         ``rows`` (one dict per element type and mesh), ``orders`` (regressed
-        convergence order per type), ``table`` (markdown) and ``path``.
+        convergence order per type), ``errors``, ``reused``, ``figures``,
+        ``table`` (markdown) and ``path``.
     """
-    names = list(elements) if elements is not None else available_elements()
+    o = settings(FULL, QUICK, quick, dict(elements=elements, n_elements=n_elements, repeats=repeats))
+    names = list(o["elements"]) if o["elements"] else available_elements()
     for name in names:
         if name not in available_elements():
             raise ValueError(f"`elements` must name types of {available_elements()}, got {name!r}.")
-    meshes = [n for n in n_elements if n <= 16] if quick else list(n_elements)
-    repeats = 1 if quick else repeats
-    tick = Progress("cantilever", len(names) * len(meshes), progress)
-    rows = []
-    for name in names:
-        for n in meshes:
-            row = solve_case(name, n, repeats)
-            rows.append(row)
-            tick(f"{name} {n:3d} el: error {row['error']:.3e}, {row['iterations']} its, {row['cpu']:.3f} s")
+    path = output_dir("cantilever", out, quick) if (plots or out is not None) else None
+    cases = [Case(element=name, n=n, repeats=o["repeats"], label=f"{name} {n} el")
+             for name in names for n in o["n_elements"]]
+    # serial: the CPU times are the study's result and must not share the machine with a sweep
+    sweep = run_cases(run_case, cases, out=path, name="cantilever", progress=progress,
+                      reduce=lambda r: {k: v for k, v in r.items() if k != "result"})
+    rows = sweep.finished()
     orders = {}
     for name in names:
         rs = [r for r in rows if r["element"] == name and r["n_elements"] >= 4]
@@ -178,26 +235,23 @@ def run(elements=None, n_elements=(1, 2, 4, 8, 16, 32, 64), quick: bool = False,
     table = markdown_table(headers, table_rows)
     table += "\nConvergence order (log-log fit, 4 elements and up): " + ", ".join(
         f"{k} {v:.2f}" for k, v in orders.items()) + "\n"
-    path = None
+    if sweep.errors:
+        table += "\nCases that raised (not in the table): " + "; ".join(
+            f"{k}: {v}" for k, v in sweep.errors.items()) + "\n"
+    figures = {}
     if plots:
-        path = output_dir("cantilever", out)
         (path / "table2.md").write_text("# B1 largely deforming cantilever (chapter Table 2)\n\n" + table)
-        _plots(rows, path)
-    return {"rows": rows, "orders": orders, "table": table, "path": path}
+        figures = _plots(rows, orders, path)
+    return {"rows": rows, "orders": orders, "errors": sweep.errors, "reused": sweep.reused, "figures": figures,
+            "table": table, "path": path}
 
 
-def main(argv=None):
-    """Command-line entry: ``python -m ancfdae.studies.cantilever [--quick]``."""
-    import argparse
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--quick", action="store_true")
-    p.add_argument("--out", default=None)
-    p.add_argument("--elements", nargs="*", default=None)
-    args = p.parse_args(argv)
-    res = run(elements=args.elements, quick=args.quick, out=args.out)
-    print(res["table"])
-    print(f"written to {res['path']}")
+def main(argv=None) -> int:
+    """Command-line entry: ``python -m ancfdae.studies.cantilever --help``."""
+    import sys
+    from ._cli import main as cli_main
+    return cli_main(sys.modules[__name__], argv)
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

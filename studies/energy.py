@@ -17,14 +17,16 @@ Run: ``ancfdae study energy [--quick] [--out DIR] [--jobs N]``.
 from __future__ import annotations
 
 import os
-import pickle
 
 import numpy as np
 
-from ._common import Progress, markdown_table, output_dir, run_cases
-from ._flying import T_HAT, T_PULSE, Case, available, b2_beam, b3_beam, simulate_case, steady_drift
+from ancfdae.simulate import METHODS
 
-__all__ = ["run", "run_case", "INTEGRATORS"]
+from ._cli import Option
+from ._common import Case, markdown_table, output_dir, run_cases, settings
+from ._flying import T_HAT, T_PULSE, available, b2_beam, b3_beam, simulate_case, steady_drift, unpack
+
+__all__ = ["run", "run_case", "INTEGRATORS", "FULL", "QUICK", "CLI_OPTIONS"]
 
 #: label -> (simulate method, options)
 INTEGRATORS = {
@@ -35,8 +37,24 @@ INTEGRATORS = {
     "generalized-alpha": ("generalized-alpha", {"rho_inf": 0.8}),
     "ida": ("ida", {"rtol": 1e-6, "max_steps": 400_000}),
 }
+if "energy-momentum" in METHODS:
+    INTEGRATORS["energy-momentum"] = ("energy-momentum", {})
 #: element -> (problem, elements)
 ELEMENTS = {"BE2D": ("B2", 4), "SQ2D": ("B2", 4), "BE3D": ("B3", 4), "SQ3D": ("B3", 4)}
+
+#: defaults of the full study
+FULL = dict(elements=tuple(ELEMENTS), integrators=tuple(INTEGRATORS), n=None, t_end_b2=10.0, t_end_b3=6.0, h=2e-3,
+            dt_out=0.02)
+#: quick mode (the tests): BE2D, 2 elements, 4 s, h = 4e-3
+QUICK = dict(elements=("BE2D",), n=2, t_end_b2=4.0, t_end_b3=4.0, h=4e-3)
+CLI_OPTIONS = [
+    Option("elements", str, "element types (planar: B2, spatial: B3)", nargs="+", choices=tuple(ELEMENTS)),
+    Option("integrators", str, "integrators", nargs="+", choices=tuple(INTEGRATORS)),
+    Option("n", int, "elements per beam (default of each type: 4)"),
+    Option("t_end_b2", float, "end time of the planar runs (s)"),
+    Option("t_end_b3", float, "end time of the spatial runs (s)"),
+    Option("h", float, "time step of the fixed-step methods (s)"),
+]
 
 
 def run_case(case: dict) -> dict:
@@ -65,13 +83,14 @@ def summarize(rec: dict) -> dict:
             "t_fail": rec["t_fail"], "t_blow_up": en["t_blow_up"], "energy": e_load,
             "drift": d["max"], "rate": d["rate"], "final": d["final"],
             "relative": d["max"] / abs(e_load) if np.isfinite(e_load) and e_load else float("nan"),
-            "cpu": rec["cpu"], "steps": rec["stats"].get("steps", 0), "message": rec["message"]}
+            "cpu": rec["cpu"], "steps": rec["stats"].get("steps", 0), "message": rec["message"],
+            "max_order": rec["stats"].get("max_order") or rec.get("options", {}).get("max_order")}
 
 
-def run(elements=None, integrators=tuple(INTEGRATORS), n: int | None = None, t_end_b2: float = 10.0,
-        t_end_b3: float = 6.0, h: float = 2e-3, dt_out: float = 0.02, quick: bool = False, out=None,
-        jobs: int | None = None, executor=None, plots: bool = True, progress: bool = True) -> dict:
-    """Run the study.
+def run(elements=None, integrators=None, n: int | None = None, t_end_b2=None, t_end_b3=None, h=None, dt_out=None,
+        quick: bool = False, out=None, jobs: int | None = None, executor=None, plots: bool = True,
+        progress: bool = True) -> dict:
+    """Run the study. Every option left None takes its value from :data:`FULL` (:data:`QUICK` with ``quick``).
 
     Parameters
     ----------
@@ -96,62 +115,66 @@ def run(elements=None, integrators=tuple(INTEGRATORS), n: int | None = None, t_e
     Returns
     -------
     dict
-        ``rows`` (summary per run), ``records`` (histories), ``table``, ``path``.
+        ``rows`` (summary per run), ``records`` (histories), ``errors``,
+        ``reused``, ``figures``, ``table``, ``path``.
     """
-    names = available(elements if elements is not None else ELEMENTS)
-    if elements is not None and len(names) != len(list(elements)):
-        raise ValueError(f"`elements` must name types of {available(ELEMENTS)}, got {list(elements)}.")
-    unknown = [i for i in integrators if i not in INTEGRATORS]
+    o = settings(FULL, QUICK, quick, dict(elements=elements, integrators=integrators, n=n, t_end_b2=t_end_b2,
+                                          t_end_b3=t_end_b3, h=h, dt_out=dt_out))
+    names = available(o["elements"])
+    if len(names) != len(list(o["elements"])) or not names:
+        raise ValueError(f"`elements` must name types of {available(ELEMENTS)}, got {list(o['elements'])}.")
+    unknown = [i for i in o["integrators"] if i not in INTEGRATORS]
     if unknown:
         raise ValueError(f"`integrators` must be keys of {list(INTEGRATORS)}, got {unknown}.")
-    if quick:
-        names = ["BE2D"] if elements is None else names
-        n, t_end_b2, t_end_b3, h = 2, 4.0, 4.0, 4e-3
+    path = output_dir("energy", out, quick) if (plots or out is not None) else None
     cases = []
     for name in names:
         problem, n_default = ELEMENTS[name]
-        for integ in integrators:
+        for integ in o["integrators"]:
             if name == "BE3D" and integ == "ida":
                 continue   # the director update restarts IDA after every step (BDF history lost): hours
-            c = {"element": name, "n": n or n_default, "problem": problem, "integrator": integ, "h": h,
-                 "t_end": t_end_b2 if problem == "B2" else t_end_b3, "dt_out": dt_out}
+            c = {"element": name, "n": o["n"] or n_default, "problem": problem, "integrator": integ, "h": o["h"],
+                 "t_end": o["t_end_b2"] if problem == "B2" else o["t_end_b3"], "dt_out": o["dt_out"]}
             cost = c["t_end"] * c["n"] * (1 if name == "BE2D" else 3 if name in ("SQ2D", "BE3D") else 10)
             cases.append(Case(c, label=f"{name} {c['n']} el ({problem}) {integ}", cost=cost))
     cases.sort(key=lambda c: -c["cost"])
-    records = run_cases(run_case, cases, executor=executor, jobs=jobs,
-                        progress=Progress("energy", len(cases), progress))
+    sweep = run_cases(run_case, cases, out=path, executor=executor, jobs=jobs, reduce=unpack, name="energy",
+                      progress=progress, cost=lambda c: c["cost"])
+    records = sweep.finished()
     key = {k: i for i, k in enumerate(INTEGRATORS)}
     records.sort(key=lambda r: (list(ELEMENTS).index(r["element"]), key[r["integrator"]]))
-    path = output_dir("energy", out) if plots else None
-    if path is not None:   # keep the histories: post-processing can be redone without the runs
-        with open(path / "records.pkl", "wb") as f:
-            pickle.dump(records, f)
     rows = [summarize(r) for r in records]
-    table = _table(rows, h)
+    table = _table(rows, o["h"], sweep.errors)
+    figures = {}
     if plots:
         (path / "energy.md").write_text("# Energy drift in free flight\n\n" + table)
-        _plot(records, path)
-    return {"rows": rows, "records": records, "table": table, "path": path}
+        figures = _plot(records, path)
+    return {"rows": rows, "records": records, "errors": sweep.errors, "reused": sweep.reused, "figures": figures,
+            "table": table, "path": path}
 
 
 def _f(x, spec):
     return "-" if x is None or (isinstance(x, float) and not np.isfinite(x)) else format(x, spec)
 
 
-def _table(rows, h):
+def _table(rows, h, errors):
     headers = ["element", "problem", "integrator", "run to (s)", "reached (s)", "fails at (s)", "blow-up at (s)",
                "T+U at load end (J)", "max drift after load (J)", "relative", "rate (J/s)", "CPU (s)"]
     body = [[r["element"] + f" {r['n']} el", r["problem"], r["integrator"], f"{r['t_end']:g}",
              f"{r['t_reached']:.2f}", _f(r["t_fail"], ".2f") if r["failed"] else "-", _f(r["t_blow_up"], ".2f"),
              _f(r["energy"], ".4g"), _f(r["drift"], ".2e"), _f(r["relative"], ".1e"), _f(r["rate"], ".1e"),
              f"{r['cpu']:.1f}"] for r in rows]
-    text = (f"Fixed-step methods: h = {h:g} s, modified Newton tol 1e-8; IDA: rtol 1e-6, max order 2, "
-            "at most 400 000 steps. "
+    ida = sorted({r["max_order"] for r in rows if r["integrator"] == "ida" and r["max_order"] is not None})
+    text = (f"Fixed-step methods: h = {h:g} s, modified Newton tol 1e-8; IDA: rtol 1e-6"
+            + (f", max order {', '.join(map(str, ida))}" if ida else "") + ", at most 400 000 steps. "
             "Planar elements: B2 (load ends at 2.5 s); spatial: B3 (load ends at 3 s).\n\n")
-    return text + markdown_table(headers, body)
+    text += markdown_table(headers, body)
+    if errors:
+        text += "\nCases that raised (not in the table): " + "; ".join(f"{k}: {v}" for k, v in errors.items()) + "\n"
+    return text
 
 
-def _plot(records, path):
+def _plot(records, path) -> dict:
     from ._flying_plots import figure, save
     names = list(dict.fromkeys(r["element"] for r in records))
     cols = min(2, len(names))
@@ -164,10 +187,13 @@ def _plot(records, path):
             if m.sum() < 2:
                 continue
             bal = r["energy"]["balance"][m]
-            ax.semilogy(r["t"][m], np.abs(bal - bal[0]) + 1e-14, color=f"C{k}", lw=1, label=r["integrator"])
+            # Newmark (1/4, 1/2) and Lobatto IIIA-2 are the same scheme: styles keep coinciding curves visible
+            ax.semilogy(r["t"][m], np.abs(bal - bal[0]) + 1e-14, color=f"C{k}", lw=2.0 - 0.25 * k,
+                        ls=("-", "--", ":", "-.")[k % 4], label=r["integrator"])
         ax.set(xlabel="t (s)", ylabel="|E(t) - E(t_load)| (J)", title=f"{name}: energy drift after the load")
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7)
     for ax in axes.ravel()[len(names):]:
         ax.set_visible(False)
-    save(fig, path, "energy_drift.png")
+    save(fig, path, "energy_drift")
+    return {"energy_drift": fig}

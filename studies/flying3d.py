@@ -1,7 +1,7 @@
 """Free beam flying in space: energy of BE3D against SQ3D, failure times (B3, chapter Sect. 5.3, Figs. 11-12).
 
-The B3 beam (benchmarks.md; :mod:`studies._flying`) is loaded at B by the
-dead moment ``f(t) (0.4, 0.2, 0.8) N m`` with a hat ramp that ends at 3 s, and
+The B3 beam (revision 2; :mod:`studies._flying`) is loaded at B by the
+dead moment ``f(t) (0.1, 0.05, 0.2) N m`` with a hat ramp that ends at 3 s, and
 integrated by Lobatto IIIA (3 stages, h = 1e-3 s, modified Newton, tol 1e-8)
 with BE3D (thin, torsion angle + director, Sects. 3.5-3.6) and SQ3D
 (shear- and cross-section deformable, Sect. 4). Per run the study records the
@@ -16,20 +16,55 @@ every step: the model is wrapped so that ``T + U`` is evaluated just before
 and just after each update; the sum of these jumps is energy that the update
 itself puts into or takes out of the discrete system -- between updates
 BE3D's semi-discrete equations derive from one Lagrangian and conserve
-energy (see ``ancfdae/models/_be3d_dynamics.py``).
+energy (see ``ancfdae/models/_be3d_dynamics.py``). Divided by the number of
+updates it is the energy injected per director update. Where the
+``"energy-momentum"`` integrator is available, BE3D also runs with it: it
+conserves the discrete energy between updates, so its whole balance error is
+the updates' share.
 
-Run: ``ancfdae study flying3d [--quick] [--out DIR] [--jobs N]``.
+The chapter's BE3D runs failed after 8, 9 and 12 s (8, 16, 32 elements); the
+table and Fig. 11 show them beside ours.
+
+Run: ``ancfdae study flying3d [--quick] [--out DIR] [--jobs N] [--be-meshes ...] [--methods ...]``.
 """
 from __future__ import annotations
 
-import pickle
-
 import numpy as np
 
-from ._common import command_line, Progress, markdown_table, output_dir, run_cases
-from ._flying import T_HAT, Case, available, b3_beam, simulate_case, steady_drift
+from ancfdae.simulate import METHODS
 
-__all__ = ["run", "run_case", "UpdateAudit"]
+from ._cli import Option
+from ._common import Case, markdown_table, output_dir, run_cases, settings
+from ._flying import T_HAT, available, b3_beam, simulate_case, steady_drift, unpack
+
+__all__ = ["run", "run_case", "summarize", "UpdateAudit", "FULL", "QUICK", "CLI_OPTIONS", "CHAPTER_FAILURES"]
+
+#: Chapter Sect. 5.3: BE3D runs failed to converge after 8, 9 and 12 s with 8, 16 and 32 elements.
+CHAPTER_FAILURES = {8: 8.0, 16: 9.0, 32: 12.0}
+
+#: BE3D integrators: Lobatto IIIA (the chapter's), and the energy-momentum method where ancfdae has it
+_BE_METHODS = tuple(m for m in ("lobatto3", "energy-momentum") if m in METHODS)
+
+#: defaults of the full study (chapter: BE3D 8, 16, 32; SQ3D 32, 64, 128; SQ3D 16 to 50 s)
+FULL = dict(be_meshes=(8, 16, 32), sq_meshes=(32, 64, 128), variants=("projected", "post-rotated", "none"),
+            variant_mesh=8, methods=_BE_METHODS, long_run=(16, 50.0), t_end=20.0, t_end_sq=20.0, h=1e-3,
+            dt_out=0.01, t_load=T_HAT, sq_steps=None)
+#: quick mode (the tests): the hat shortened to 1 s; BE3D and SQ3D with 2 elements to 1.5 s
+QUICK = dict(be_meshes=(2,), sq_meshes=(2,), variants=("projected",), methods=("lobatto3",), long_run=(),
+             t_end=1.5, t_end_sq=1.5, h=2e-3, dt_out=0.02, t_load=1.0, sq_steps=(4e-3, 2e-3))
+CLI_OPTIONS = [
+    Option("be_meshes", int, "BE3D meshes", nargs="+"),
+    Option("sq_meshes", int, "SQ3D meshes", nargs="+"),
+    Option("variants", str, "BE3D director updates (the first on every mesh, the others on --variant-mesh)",
+           nargs="+", choices=("projected", "post-rotated", "none")),
+    Option("variant_mesh", int, "BE3D mesh of the other director updates"),
+    Option("methods", str, "BE3D integrators (the first on every mesh, the others on --variant-mesh)", nargs="+",
+           choices=tuple(sorted(METHODS))),
+    Option("long_run", float, "elements and end time of one long SQ3D run (none: give 0 0)", nargs=2),
+    Option("t_end", float, "end time of the BE3D runs (s)"),
+    Option("t_end_sq", float, "end time of the SQ3D runs (s)"),
+    Option("h", float, "time step (s)"),
+]
 
 
 class UpdateAudit:
@@ -63,26 +98,42 @@ class UpdateAudit:
 
 
 def run_case(case: dict) -> dict:
-    """One B3 run: ``case = {element, n, t_end, h, dt_out, t_load[, director_update]}``."""
+    """One B3 run: ``case = {element, n, t_end, h, dt_out, t_load[, director_update, method]}``.
+
+    For BE3D the energy jumps at the director updates are kept in the
+    Result's monitor ``director_update``: ``cumulative`` (their running sum at
+    the output times), ``count`` and ``max_abs``.
+    """
     opts = {"director_update": case["director_update"]} if case.get("director_update") else {}
     beam = b3_beam(case["element"], case["n"], t_load=case["t_load"], **opts)
     model = UpdateAudit(beam) if case["element"] == "BE3D" else beam
-    rec = simulate_case(model, case["t_end"], h=case["h"], dt_out=case["dt_out"])
-    rec.update(element=case["element"], n=case["n"], director_update=case.get("director_update") or "-",
-               t_end=case["t_end"], t_load=case["t_load"], h=case["h"], long=bool(case.get("long")),
-               label=case["label"])
-    rec["t_end_reached"] = float(rec["t"][-1]) if rec["t"].size else 0.0
+    rec = simulate_case(model, case["t_end"], method=case.get("method", "lobatto3"), h=case["h"],
+                        dt_out=case["dt_out"])
     if isinstance(model, UpdateAudit):
+        res = rec["result"]
         jumps = np.array(model.jumps).reshape(-1, 2)
-        rec["update_jumps"] = jumps
+        upto = np.searchsorted(jumps[:, 0], res.t + 1e-12, side="right")     # updates at or before each output
+        cumulative = np.concatenate([[0.0], np.cumsum(jumps[:, 1])])[upto]
+        res.monitors["director_update"] = {"cumulative": cumulative, "count": int(jumps.shape[0]),
+                                           "max_abs": float(np.max(np.abs(jumps[:, 1]))) if jumps.size else 0.0}
+    rec.update(element=case["element"], n=case["n"], director_update=case.get("director_update") or "-",
+               method=case.get("method", "lobatto3"), t_end=case["t_end"], t_load=case["t_load"], h=case["h"],
+               long=bool(case.get("long")), label=case["label"])
+    return rec
+
+
+def _unpack(record):
+    rec = unpack(record)
+    rec["t_end_reached"] = float(rec["t"][-1]) if rec["t"].size else 0.0
     return rec
 
 
 def summarize(rec: dict) -> dict:
     """Key numbers of one run: failure and blow-up times, balance during and drift after the load."""
     t, en = rec["t"], rec["energy"]
-    row = {k: rec[k] for k in ("element", "n", "director_update", "dof", "status", "message", "t_end_reached",
-                               "t_end", "t_load", "h", "cpu")}
+    row = {k: rec[k] for k in ("element", "n", "director_update", "method", "dof", "status", "message",
+                               "t_end_reached", "t_end", "t_load", "h", "cpu")}
+    row["chapter_fails"] = CHAPTER_FAILURES.get(rec["n"]) if rec["element"] == "BE3D" else None
     t_load = rec["t_load"]
     row["t_fail"] = rec["t_fail"]
     row["t_blow_up"] = en["t_blow_up"]
@@ -96,52 +147,72 @@ def summarize(rec: dict) -> dict:
     scale = row["energy_at_load_end"] if np.isfinite(row["energy_at_load_end"]) else float(np.nanmax(en["total"]))
     off = np.flatnonzero(~(np.abs(bal) <= 0.01 * abs(scale)))
     row["t_drift_1pc"] = float(t[off[0]]) if off.size else None
-    if "update_jumps" in rec and rec["update_jumps"].size:
-        tj, jj = rec["update_jumps"][:, 0], rec["update_jumps"][:, 1]
-        load = tj <= t_load
-        row["update_net_load"] = float(np.sum(jj[load]))
-        row["update_net_free"] = float(np.sum(jj[~load]))
-        row["update_max"] = float(np.max(np.abs(jj)))
+    audit = rec["monitors"].get("director_update")
+    if audit is not None and audit["count"]:
+        cum, t_ = np.asarray(audit["cumulative"]), t
+        k = min(k3, t_.size - 1)
+        row["update_net_load"] = float(cum[k])
+        row["update_net_free"] = float(cum[-1] - cum[k])
+        row["update_max"] = float(audit["max_abs"])
+        row["update_mean"] = float(cum[-1] / audit["count"])
+        row["update_count"] = int(audit["count"])
     return row
 
 
-def _cases(be_meshes, sq_meshes, variants, variant_mesh, long_run, t_end, t_end_sq, h, dt_out, t_load=T_HAT,
-           sq_steps=None):
+def _cases(o):
     cases = []
-    for n in be_meshes:
-        cases.append({"element": "BE3D", "n": n, "director_update": variants[0], "t_end": t_end, "h": h})
-    for var in variants[1:]:
-        cases.append({"element": "BE3D", "n": variant_mesh, "director_update": var, "t_end": t_end, "h": h})
-    for n in sq_meshes:
-        cases += [{"element": "SQ3D", "n": n, "t_end": t_end_sq, "h": hs} for hs in (sq_steps or (h,))]
-    if long_run:
-        cases.append({"element": "SQ3D", "n": long_run[0], "t_end": long_run[1], "h": h, "long": True})
+    be = available(("BE3D",)) and o["be_meshes"]
+    methods = list(o["methods"]) or ["lobatto3"]
+    for n in (o["be_meshes"] if be else ()):
+        cases.append({"element": "BE3D", "n": n, "director_update": o["variants"][0], "method": methods[0],
+                      "t_end": o["t_end"], "h": o["h"]})
+    for var in (o["variants"][1:] if be else ()):
+        cases.append({"element": "BE3D", "n": o["variant_mesh"], "director_update": var, "method": methods[0],
+                      "t_end": o["t_end"], "h": o["h"]})
+    for m in (methods[1:] if be else ()):
+        cases.append({"element": "BE3D", "n": o["variant_mesh"], "director_update": o["variants"][0], "method": m,
+                      "t_end": o["t_end"], "h": o["h"]})
+    if available(("SQ3D",)):
+        for n in o["sq_meshes"]:
+            cases += [{"element": "SQ3D", "n": n, "t_end": o["t_end_sq"], "h": hs}
+                      for hs in (o["sq_steps"] or (o["h"],))]
+        if o["long_run"] and o["long_run"][0]:
+            cases.append({"element": "SQ3D", "n": int(o["long_run"][0]), "t_end": float(o["long_run"][1]),
+                          "h": o["h"], "long": True})
     out = []
     for c in cases:
         label = f"{c['element']} {c['n']} el" + (f" ({c['director_update']})" if c.get("director_update") else "") \
-            + f" h {c['h']:g} to {c['t_end']:g} s"
-        out.append(Case(c, dt_out=dt_out, t_load=t_load, label=label))
-    # SQ3D runs go to the end; BE3D runs usually stop early: start the long ones first.
-    out.sort(key=lambda c: -(c["t_end"] * c["n"] / c["h"] * (3.0 if c["element"] == "SQ3D" else 0.3)))
+            + (f" {c['method']}" if c.get("method", "lobatto3") != "lobatto3" else "") \
+            + f" h {c['h']:g} to {c['t_end']:g} s" + (" long" if c.get("long") else "")
+        out.append(Case(c, dt_out=o["dt_out"], t_load=o["t_load"], label=label))
+    out.sort(key=lambda c: -_cost(c))      # the long ones first: better balanced pools
     return out
 
 
-def run(be_meshes=(8, 16, 32), sq_meshes=(32, 64, 128), variants=("projected", "post-rotated", "none"),
-        variant_mesh: int = 8, long_run=(16, 50.0), t_end: float = 20.0, t_end_sq: float = 20.0, h: float = 1e-3,
-        dt_out: float = 0.01, quick: bool = False, out=None, jobs: int | None = None, executor=None,
+def _cost(case):
+    # relative CPU cost; SQ3D runs go to the end, BE3D runs usually stop early
+    return case["t_end"] * case["n"] / case["h"] * (3.0 if case["element"] == "SQ3D" else 0.3)
+
+
+def run(be_meshes=None, sq_meshes=None, variants=None, variant_mesh=None, methods=None, long_run=None, t_end=None,
+        t_end_sq=None, h=None, dt_out=None, quick: bool = False, out=None, jobs: int | None = None, executor=None,
         plots: bool = True, progress: bool = True) -> dict:
-    """Run the study.
+    """Run the study. Every option left None takes its value from :data:`FULL` (:data:`QUICK` with ``quick``).
 
     Parameters
     ----------
     be_meshes : sequence of int
-        BE3D meshes (chapter: 8, 16, 32), run with ``variants[0]``.
+        BE3D meshes (chapter: 8, 16, 32), run with ``variants[0]`` and ``methods[0]``.
     sq_meshes : sequence of int
         SQ3D meshes (chapter: 32, 64, 128).
     variants : sequence of str
         BE3D director updates (Sect. 3.6): the first is used on every mesh,
         the others on ``variant_mesh`` elements only.
-    long_run : (int, float) or None
+    variant_mesh : int
+    methods : sequence of str
+        BE3D integrators: the first on every mesh, the others (default: the
+        energy-momentum method where available) on ``variant_mesh`` elements.
+    long_run : (int, float) or ()
         ``(elements, t_end)`` of one long SQ3D run (chapter: to 50 s).
     t_end, t_end_sq : float
         End times of the BE3D and the SQ3D runs.
@@ -156,68 +227,73 @@ def run(be_meshes=(8, 16, 32), sq_meshes=(32, 64, 128), variants=("projected", "
     Returns
     -------
     dict
-        ``rows`` (summary per run), ``records`` (histories), ``table``, ``path``.
+        ``rows`` (summary per run), ``records`` (histories), ``errors``,
+        ``reused``, ``figures``, ``table``, ``path``.
     """
+    o = settings(FULL, QUICK, quick, dict(be_meshes=be_meshes, sq_meshes=sq_meshes, variants=variants,
+                                          variant_mesh=variant_mesh, methods=methods, long_run=long_run, t_end=t_end,
+                                          t_end_sq=t_end_sq, h=h, dt_out=dt_out))
+    unknown = [m for m in o["methods"] if m not in METHODS]
+    if unknown:
+        raise ValueError(f"`methods` must be keys of {sorted(METHODS)}, got {unknown}.")
     missing = [n for n in ("BE3D", "SQ3D") if n not in available(("BE3D", "SQ3D"))]
-    t_load, sq_steps = T_HAT, None
-    if quick:
-        # The moment hat shortened to 1 s (same peak); SQ3D at two steps for the order of its energy error.
-        be_meshes, sq_meshes, variants, long_run = (2,), (2,), variants[:1], None
-        t_end, t_end_sq, h, dt_out, t_load, sq_steps = 1.5, 1.5, 2e-3, 0.02, 1.0, (4e-3, 2e-3)
-    if "BE3D" in missing:
-        be_meshes, variants = (), variants[:1]
-    if "SQ3D" in missing:
-        sq_meshes, long_run = (), None
-    cases = _cases(be_meshes, sq_meshes, variants, variant_mesh, long_run, t_end, t_end_sq, h, dt_out, t_load,
-                   sq_steps)
+    cases = _cases(o)
     if not cases:
-        raise RuntimeError("flying3d needs BE3D or SQ3D in ancfdae.models; neither is available.")
-    records = run_cases(run_case, cases, executor=executor, jobs=jobs,
-                        progress=Progress("flying3d", len(cases), progress))
+        raise ValueError("flying3d has no case to run: no BE3D/SQ3D meshes, or neither type in ancfdae.models.")
+    path = output_dir("flying3d", out, quick) if (plots or out is not None) else None
+    sweep = run_cases(run_case, cases, out=path, executor=executor, jobs=jobs, reduce=_unpack, name="flying3d",
+                      progress=progress, cost=_cost)
+    records = sweep.finished()
     order = {"BE3D": 0, "SQ3D": 1}
-    records.sort(key=lambda r: (order[r["element"]], r["director_update"] != variants[0], r["t_end"], r["n"],
-                                -r["h"]))
-    path = output_dir("flying3d", out) if plots else None
-    if path is not None:   # keep the histories: post-processing can be redone without the runs
-        with open(path / "records.pkl", "wb") as f:
-            pickle.dump(records, f)
+    records.sort(key=lambda r: (order[r["element"]], r["director_update"] != o["variants"][0],
+                                r["method"] != (list(o["methods"]) or ["lobatto3"])[0], r["t_end"], r["n"], -r["h"]))
     rows = [summarize(r) for r in records]
-    table = _table(rows, h, missing)
+    table = _table(rows, missing, sweep.errors)
+    figures = {}
     if plots:
         (path / "flying3d.md").write_text("# B3 free beam flying in space (chapter Sect. 5.3)\n\n" + table)
         from ._flying_plots import plot_flying3d
-        plot_flying3d(records, path)
-    return {"rows": rows, "records": records, "table": table, "path": path}
+        figures = plot_flying3d(records, path, {n: t for n, t in CHAPTER_FAILURES.items() if n in o["be_meshes"]})
+    return {"rows": rows, "records": records, "errors": sweep.errors, "reused": sweep.reused, "figures": figures,
+            "table": table, "path": path}
 
 
 def _fmt(x, spec=".3g"):
     return "-" if x is None or (isinstance(x, float) and not np.isfinite(x)) else format(x, spec)
 
 
-def _table(rows, h, missing):
-    headers = ["element", "#NEL", "director update", "h (s)", "run to (s)", "fails at (s)", "blow-up flagged (s)",
-               "balance off by 1 % at (s)", "T+U at load end (J)", "balance at load end (J)", "drift after load (J)",
-               "drift rate (J/s)", "update jumps, load / free (J)", "CPU (s)"]
+def _table(rows, missing, errors):
+    headers = ["element", "#NEL", "director update", "integrator", "h (s)", "run to (s)", "fails at (s)",
+               "chapter: fails at (s)", "blow-up flagged (s)", "balance off by 1 % at (s)", "T+U at load end (J)",
+               "balance at load end (J)", "drift after load (J)", "drift rate (J/s)",
+               "update jumps, load / free (J)", "per update: mean / max (J)", "CPU (s)"]
     body = []
     for r in rows:
-        jumps = "-" if "update_net_load" not in r else f"{r['update_net_load']:.2e} / {r['update_net_free']:.2e}"
-        body.append([r["element"], r["n"], r["director_update"], f"{r['h']:g}", f"{r['t_end']:g}",
+        jumps = per = "-"
+        if "update_net_load" in r:
+            jumps = f"{r['update_net_load']:.2e} / {r['update_net_free']:.2e}"
+            per = f"{r['update_mean']:.1e} / {r['update_max']:.1e}"
+        body.append([r["element"], r["n"], r["director_update"], r["method"], f"{r['h']:g}", f"{r['t_end']:g}",
                      _fmt(r["t_fail"], ".3f") if r["status"] != "success" else "-",
-                     _fmt(r["t_blow_up"], ".2f"), _fmt(r["t_drift_1pc"], ".2f"),
+                     _fmt(r["chapter_fails"], "g"), _fmt(r["t_blow_up"], ".2f"), _fmt(r["t_drift_1pc"], ".2f"),
                      _fmt(r["energy_at_load_end"], ".4g"), _fmt(r["balance_at_load_end"], ".2e"),
-                     _fmt(r["drift_max"], ".2e"), _fmt(r["drift_rate"], ".2e"), jumps, f"{r['cpu']:.0f}"])
+                     _fmt(r["drift_max"], ".2e"), _fmt(r["drift_rate"], ".2e"), jumps, per, f"{r['cpu']:.0f}"])
     t_load = rows[0]["t_load"] if rows else T_HAT
-    text = f"Lobatto IIIA (3 stages), modified Newton tol 1e-8; the moment ends at {t_load:g} s.\n\n"
+    text = f"Modified Newton tol 1e-8; the moment ends at {t_load:g} s. Chapter: Lobatto IIIA, h = 1e-3 s.\n\n"
     text += markdown_table(headers, body)
     if missing:
         text += f"\nNot available in ancfdae.models: {', '.join(missing)}.\n"
+    if errors:
+        text += "\nCases that raised (not in the table): " + "; ".join(f"{k}: {v}" for k, v in errors.items()) + "\n"
     return text
 
 
-def main(argv=None):
-    """Command-line entry: ``python -m ancfdae.studies.flying3d [--quick] [--out DIR] [--jobs N]``."""
-    command_line(run, __doc__, argv)
+def main(argv=None) -> int:
+    """Command-line entry: ``python -m ancfdae.studies.flying3d --help``."""
+    import sys
+    from ._cli import main as cli_main
+    return cli_main(sys.modules[__name__], argv)
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

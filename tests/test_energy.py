@@ -19,11 +19,11 @@ T_EVAL = np.linspace(0.0, T_END, 71)
 
 
 def b2_beam(n_elements=4):
-    """benchmarks.md B2: L = 1, a = 0.05, E = 1e5, nu = 0.3, rho = 2500, r(s) = s (0.6, 0.8)."""
+    """The B2 beam (revision 2): L = 1, a = 0.05, E = 1e5, nu = 0.3, rho = 2500, r(s) = s (0.6, 0.8), 0.24 N, 0.24 N m."""
     el = BE2D(Material(E=1e5, nu=0.3, rho=2500.0), RectangularSection(0.05))
     return Beam(el, n_elements=n_elements, length=1.0, direction=(0.6, 0.8),
-                loads=[PointForce((0.8, 0.0), node=0, time=pulse(T_LOAD)),
-                       PointMoment(0.8, node=0, time=pulse(T_LOAD))])
+                loads=[PointForce((0.24, 0.0), node=0, time=pulse(T_LOAD)),
+                       PointMoment(0.24, node=0, time=pulse(T_LOAD))])
 
 
 @functools.lru_cache(maxsize=None)
@@ -56,16 +56,30 @@ def test_b2_balance_kept_to_the_order(method, declared):
 
 
 def test_b2_generalized_alpha_dissipates():
-    ga, nm = b2_run("generalized-alpha", 0.005, rho_inf=0.5), b2_run("newmark", 0.005)
-    E = ga.monitors["energy"]["balance"][ga.t >= T_LOAD - 1e-12]
-    assert E[-1] < E[0] - 5 * free_drift(nm)  # energy lost, far beyond the trapezoidal rule's error
-    # the loss grows over the free motion (a trend, not noise)
-    assert np.polyfit(np.arange(E.size), E, 1)[0] < 0
+    """Generalized-alpha with rho_inf = 0 loses energy in free flight; the trapezoidal rule does not.
+
+    B2 (revision 2) is gentle: over 1 s the loss hides in the balance's oscillation, so the mean
+    of the balance over [8, 10] s is compared with its mean over [2.5, 4.5] s. Measured (h = 5e-3):
+    generalized-alpha -4.1e-4 J, Newmark +8e-6 J.
+    """
+    t_end, t_eval = 10.0, np.linspace(0.0, 10.0, 201)
+    runs = {m: simulate(b2_beam(), (0.0, t_end), m, h=0.005, t_eval=t_eval, monitors=[EnergyMonitor()], **kw)
+            for m, kw in (("generalized-alpha", {"rho_inf": 0.0}), ("newmark", {}))}
+    change = {}
+    for m, r in runs.items():
+        E, t = r.monitors["energy"]["balance"], r.t
+        change[m] = E[t >= 8.0].mean() - E[(t >= T_LOAD) & (t < 4.5)].mean()
+    assert change["generalized-alpha"] < -20 * abs(change["newmark"]), change
 
 
 def test_b2_ida_drift_shrinks_with_rtol():
-    d = [free_drift(b2_run("ida", r)) for r in (1e-4, 1e-5)]
-    assert d[1] < 0.5 * d[0], d
+    """IDA's energy drift after the pulse falls with rtol (catches a tolerance not passed to SUNDIALS).
+
+    Measured (BDF order <= 5, B2 revision 2, 4 BE2D): 5.4e-6 J at rtol 1e-3, 5.3e-8 J at 1e-6; in
+    between the drift is at its noise level (3.3e-7 at 1e-4, 5.0e-7 at 1e-5), so the decades are wide.
+    """
+    d = [free_drift(b2_run("ida", r)) for r in (1e-3, 1e-6)]
+    assert d[1] < 0.1 * d[0], d
 
 
 def test_b2_integrators_agree_on_tip_trajectory():

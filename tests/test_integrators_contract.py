@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from ancfdae import EnergyMonitor, PointSensor, Probe, simulate
-from ancfdae.integrators._base import hermite5
+from ancfdae.integrators._hermite import hermite5
 from ancfdae.integrators import IDA, GeneralizedAlpha, LobattoIIIA, Newmark, NewtonOptions
 from toy_models import DoublePendulum, SpringChain
 
@@ -57,7 +57,7 @@ def test_contract(method, opts, model_name):
     if model_name == "chain":
         np.testing.assert_allclose(res.monitors["point@3"]["position"], res.q[:, -2:], atol=1e-12)
         np.testing.assert_allclose(res.monitors["point@3"]["velocity"], res.v[:, -2:], atol=1e-12)
-    # the model's accept_step hook ran after every accepted step, in order
+    # the model's step_event ran after every accepted step, in order
     acc = np.array(model.accepted)
     assert acc.size == res.stats["steps"] and np.all(np.diff(acc) > 0) and abs(acc[-1] - 1.0) < 1e-12
     for key in ("steps", "newton_iterations", "residual_evals", "jacobian_evals", "factorizations"):

@@ -28,7 +28,7 @@ def test_work_precision_ordering_is_stable(quick):
     for h in (1e-2, 5e-3, 2.5e-3):
         assert l3[h] < 1e-2 * l2[h]                          # order 4 against order 2 at equal h
         assert nm[h] == pytest.approx(l2[h], rel=1e-4)       # Newmark 1/4, 1/2 is the trapezoidal rule
-        assert l2[h] < hht[h] < ga[h]                        # more numerical dissipation, larger error
+        assert l2[h] < min(hht[h], ga[h])                    # numerical dissipation adds error (B2 rev. 2: 1-2 %)
     # Lobatto3 at the coarsest step beats every second-order method at the finest
     assert l3[1e-2] < 0.1 * min(l2[2.5e-3], nm[2.5e-3], hht[2.5e-3], ga[2.5e-3])
     ida = _eps(quick, "ida")
@@ -48,7 +48,14 @@ def test_modified_and_full_newton_agree_and_count_their_work(quick):
 
 def test_writes_table_and_figure(quick):
     assert "Observed order" in (quick["path"] / "integrators.md").read_text()
-    assert (quick["path"] / "work_precision.png").stat().st_size > 10_000
+    assert (quick["path"] / "work_precision.png").is_file() and (quick["path"] / "work_precision.svg").is_file()
+    work, equal_h = quick["figures"]["work_precision"].axes
+    assert work.get_xlabel() == "CPU time (s)" and equal_h.get_xlabel() == "step h (s)"
+    labels = [ln.get_label() for ln in equal_h.get_lines()]
+    assert f"lobatto3 (fitted order {quick['orders']['B2']['lobatto3']:.2f})" in labels
+    # Newmark and Lobatto IIIA-2 coincide (the same scheme): drawn with different markers, both present
+    markers = {ln.get_label().split(" ")[0]: ln.get_marker() for ln in work.get_lines()}
+    assert markers["newmark"] != markers["lobatto2"] and "ida" in markers
 
 
 def test_rejects_unknown_method():

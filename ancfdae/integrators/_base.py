@@ -14,12 +14,11 @@ import numpy as np
 import scipy.sparse as sp
 
 from ancfdae import _validate as V
-from ancfdae.integrators._hermite import hermite5
 from ancfdae.integrators._newton import NewtonOptions, NewtonSolver, NewtonStats
 from ancfdae.integrators.driver import GRID_TOL, check_model
-from ancfdae.integrators.protocol import Integrator, Quadrature, StepOutcome
+from ancfdae.integrators.protocol import Integrator, StepOutcome
 
-__all__ = ["FixedStepIntegrator", "hermite5", "Quadrature"]
+__all__ = ["FixedStepIntegrator"]
 
 #: Newton's residual floor is ROUNDOFF * eps * max|K| * max(1, max|q|): the round-off level of
 #: elastic forces (measured 4e-7 N = 1.0 eps max|K| on the 25-element BE2D pendulum, spikes to 10x).

@@ -71,6 +71,31 @@ class IDA(Integrator):
 
     Notes
     -----
+    Default ``max_order = 5``, chosen by measurement (process CPU seconds on a shared 2-core
+    machine; eps_T of chapter Eq. 115 on the tip against a converged Lobatto IIIA-3 run of the
+    same mesh; ``benchmarks/ida_vs_lobatto.py``). B2 (revision-2 loads, 8 BE2D elements,
+    [0, 4] s), rtol 1e-4 / 1e-5 / 1e-6: order <= 5 gave eps_T 1.7e-6 / 1.9e-7 / 4.2e-8 in about
+    3,500 steps and 0.8-1.2 s; order <= 4: 2.1e-5 / 2.0e-6 / 1.9e-7 (6,200 steps, 1.3-1.4 s);
+    order <= 3: 1.2e-4 / 6.3e-6 / 4.6e-7 (9,500 steps, 1.6-2.0 s); order <= 2: 3.9e-4 /
+    5.7e-5 / 5.4e-6 (0.5-1.3 s), and 2.8e-8 only at rtol 1e-9 after 77,559 steps and 10.5 s.
+    CPU to reach eps_T = 1e-6: 0.9 s (order 5), 1.4 s (4), 2.0 s (3), 1.9 s (2); Lobatto IIIA-3
+    0.7 s. The integrator study's problems (4 elements, [0, 2] s): B2, order 5 was 30-75x more
+    accurate at equal or lower CPU for rtol 1e-5..1e-7; B2 with E x 100, orders 3-5 are held by
+    stability, not accuracy (about 8,000 steps whatever rtol, eps_T 6.5e-8 at rtol 1e-6), where
+    order 2 reached 7e-7 in 1,865 steps (rtol 1e-7): for stiff undamped beams at moderate
+    accuracy ``max_order=2`` can be cheaper. (The order-2 cap of earlier versions came from a
+    linear chain, where BDF 3-5, not A-stable, forced tiny steps.)
+
+    Linear solver: "sparse" by default. On B2 above, "band" on the node-interleaved ordering
+    cost the same (0.80 vs 0.86 s to eps_T = 1e-6, within the noise of the shared machine), but
+    scikit-sundae hands a band Jacobian over as a full N x N array (8 N^2 bytes).
+
+    BE3D: an update of the directors is a model event and re-initialises IDA (order 1, small
+    first step). Updating after every step is unusable with IDA: on B3 (2 elements, rtol 1e-6)
+    20,000 steps and 20,000 restarts reached only t = 0.055 s in 100 s CPU, while with
+    ``BE3D(update_below=0.5)`` 0.2 s took 41 steps, no restart, 0.09 s CPU. Use
+    ``update_below`` with IDA.
+
     Statistics: ``newton_iterations`` counts calls of the residual, which SUNDIALS' Newton
     solver evaluates exactly once per iteration (the Jacobian is ours, no difference
     quotients); ``jacobian_evals`` = ``factorizations`` counts calls of the Jacobian (each is

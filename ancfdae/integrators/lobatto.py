@@ -21,7 +21,10 @@ the band structure of the model's matrices, has the blocks::
 
     dr_i / dA_k = delta_ik M_i + h a_ik D_i + h^2 (a^2)_ik K_i
 
-with ``K_i, D_i, M_i`` the exact Jacobian blocks at stage ``i``. A model that declares the
+with ``K_i, D_i, M_i`` the exact Jacobian blocks at stage ``i`` (full Newton). Modified Newton
+evaluates one set of blocks, at the last stage, and factorises the stage system in the eigenbasis
+of the tableau (:class:`ancfdae.integrators._linsolve.StageMatrix`): for 3 stages one complex n x n
+banded LU instead of a real 2n x 2n one. A model that declares the
 capability ``"residual_stages"`` (:mod:`ancfdae.problem`; ``residual_stages(ts, Q, V, A) -> R``,
 columns = stages, e.g. :class:`~ancfdae.models.Beam`) has all implicit stages' residuals evaluated
 in one call; otherwise one ``residual`` call per stage.
@@ -35,6 +38,7 @@ import scipy.sparse as sp
 
 from ancfdae import _validate as V
 from ancfdae.integrators._base import FixedStepIntegrator
+from ancfdae.integrators._linsolve import StageMatrix
 from ancfdae.integrators.protocol import Quadrature
 from ancfdae.problem import capabilities
 
@@ -259,6 +263,16 @@ class LobattoIIIA(FixedStepIntegrator):
             def jacobian(x):
                 X = x.reshape(n, m)
                 Q, V_ = Q0 + X @ CQ, V0 + X @ CV
+                if self.newton.options.jacobian == "modified":
+                    # Modified Newton reuses the matrix across steps anyway: one set of blocks (at
+                    # the last stage) lets the stage system split in the tableau's eigenbasis.
+                    blk = self._jacobian(ts[-1], Q[:, -1], V_[:, -1], X[:, -1])
+                    self._set_floor(blk, Q[:, -1])
+                    if blk.same_pattern:
+                        return StageMatrix(blk, h, self._a_rest)
+                    blocks = [blk if i == m - 1 else self._jacobian(ts[i], Q[:, i], V_[:, i], X[:, i])
+                              for i in range(m)]
+                    return self._matrix(blocks, h)
                 blocks = [self._jacobian(ts[i], Q[:, i], V_[:, i], X[:, i]) for i in range(m)]
                 for i, blk in enumerate(blocks):
                     self._set_floor(blk, Q[:, i])

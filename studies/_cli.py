@@ -1,0 +1,82 @@
+"""Command line of one study: ``ancfdae study NAME [--quick] [--out DIR] [--jobs N] [study options]``.
+
+Each study module lists its command-line options in ``CLI_OPTIONS`` (a list
+of :class:`Option`) and its defaults in ``FULL`` and ``QUICK`` (dicts keyed by
+the ``run`` parameter); ``--help`` shows both. An option given on the command
+line overrides the mode's default.
+"""
+from __future__ import annotations
+
+import argparse
+import inspect
+import sys
+from dataclasses import dataclass
+
+from ._common import Interrupted
+
+__all__ = ["Option", "parser", "main"]
+
+
+@dataclass(frozen=True)
+class Option:
+    """One study option: ``run`` parameter ``name``, value type, ``nargs`` ("+" for a list) and help text."""
+
+    name: str
+    type: type
+    help: str
+    nargs: str | None = None
+    choices: tuple | None = None
+
+
+def _fmt(value) -> str:
+    if isinstance(value, (list, tuple)):
+        return " ".join(_fmt(v) for v in value) if value else "(none)"
+    if value is None:
+        return "(none)"
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def parser(module, prog: str | None = None) -> argparse.ArgumentParser:
+    """The argument parser of a study module (its options, with the full and the quick defaults)."""
+    name = getattr(module, "NAME", module.__name__.rsplit(".", 1)[-1])
+    doc = (module.__doc__ or name).strip().splitlines()[0]
+    p = argparse.ArgumentParser(prog=prog or f"ancfdae study {name}", description=doc)
+    p.add_argument("--quick", action="store_true", help="small, fast version (what the tests run)")
+    p.add_argument("--out", default=None,
+                   help=f"output folder; a rerun with the same folder reuses its finished cases "
+                        f"(default: out/{name}, with --quick out/{name}-quick)")
+    if "jobs" in inspect.signature(module.run).parameters:
+        p.add_argument("--jobs", type=int, default=None,
+                       help="worker processes for the sweep (default: 1, serial, timings undisturbed)")
+    full, quick = getattr(module, "FULL", {}), getattr(module, "QUICK", {})
+    for opt in getattr(module, "CLI_OPTIONS", ()):
+        default = f"default: {_fmt(full.get(opt.name))}"
+        if opt.name in quick and quick[opt.name] != full.get(opt.name):
+            default += f"; with --quick: {_fmt(quick[opt.name])}"
+        p.add_argument("--" + opt.name.replace("_", "-"), dest=opt.name, type=opt.type, nargs=opt.nargs,
+                       choices=opt.choices, default=None, help=f"{opt.help} ({default})")
+    return p
+
+
+def main(module, argv=None, prog: str | None = None) -> int:
+    """Parse ``argv``, run the study, print its table; return the exit status (130 after Ctrl-C)."""
+    p = parser(module, prog)
+    args = vars(p.parse_args(argv))
+    if args.get("jobs") is not None and args["jobs"] < 1:
+        p.error(f"--jobs must be a positive integer, got {args['jobs']}")
+    options = {k: v for k, v in args.items() if v is not None and k not in ("quick",)}
+    try:
+        result = module.run(quick=args["quick"], **options)
+    except Interrupted as exc:
+        print(exc, file=sys.stderr)
+        return 130
+    except KeyboardInterrupt:
+        print(f"{p.prog} interrupted.", file=sys.stderr)
+        return 130
+    except ValueError as exc:           # bad options (e.g. --out an existing file): said at once
+        p.error(str(exc))
+    if result.get("table"):
+        print(result["table"])
+    if result.get("path") is not None:
+        print(f"results written to {result['path']}")
+    return 0

@@ -1,0 +1,123 @@
+"""The studies' runner keeps every finished case: stored as it finishes, reused, failures isolated, Ctrl-C safe."""
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import study_toy
+from ancfdae.result import Result
+from ancfdae.studies import _cli
+from ancfdae.studies._common import Case, output_dir, run_cases
+
+HERE = Path(__file__).parent
+ROOT = HERE.parent
+_MAIN = "import sys, study_toy; from ancfdae.studies import _cli; sys.exit(_cli.main(study_toy, sys.argv[1:]))"
+
+
+def test_each_case_is_stored_and_a_rerun_reuses_it(tmp_path):
+    res = study_toy.run(out=tmp_path, progress=False)
+    assert res["sweep"].reused == 0 and [r["square"] for r in res["sweep"].records] == [0, 1, 4, 9]
+    meta = json.loads((tmp_path / "cases" / "case_2.json").read_text())
+    assert meta["record"]["square"] == 4 and meta["case"]["i"] == 2
+    stored = Result.load(tmp_path / "cases" / meta["file"])          # the library's self-describing format
+    assert np.all(stored.q == 2.0) and stored.stats["steps"] == 3
+    again = study_toy.run(out=tmp_path, progress=False)
+    assert again["sweep"].reused == 4                                 # nothing recomputed ...
+    assert [r["square"] for r in again["sweep"].records] == [0, 1, 4, 9]
+    assert np.all(again["sweep"].records[3]["result"].q == 3.0)      # ... and the records come from the files
+    changed = study_toy.run(out=tmp_path, sleep=0.02, progress=False)
+    assert changed["sweep"].reused == 0                               # other options: the cases run again
+
+
+def test_a_case_that_raises_is_recorded_and_the_others_go_on(tmp_path):
+    res = study_toy.run(out=tmp_path, fail=1, progress=False)
+    sweep = res["sweep"]
+    assert sweep.records[1] is None and list(sweep.errors) == ["case 1"]
+    assert sweep.errors["case 1"].startswith("RuntimeError: case 1 is broken (at study_toy.py:")   # where it raised
+    assert [r["square"] for r in sweep.finished()] == [0, 4, 9]
+    assert "RuntimeError" in json.loads((tmp_path / "cases" / "case_1.json").read_text())["error"]
+    again = study_toy.run(out=tmp_path, fail=1, progress=False)
+    assert again["sweep"].reused == 3 and "case 1" in again["sweep"].errors    # the failed case is tried again
+
+
+def test_a_case_that_raises_in_a_worker_is_recorded(tmp_path):
+    res = study_toy.run(out=tmp_path, fail=0, jobs=2, progress=False)
+    assert list(res["sweep"].errors) == ["case 0"] and len(res["sweep"].finished()) == 3
+    error = res["sweep"].errors["case 0"]
+    assert "RuntimeError: case 0 is broken" in error and "study_toy.py" in error     # the worker's traceback
+
+
+def test_output_folder_checked_before_any_work(tmp_path, monkeypatch, capsys):
+    file = tmp_path / "results.txt"
+    file.write_text("not a folder")
+    calls = []
+    with pytest.raises(ValueError, match="`out` must be a folder.*existing file"):
+        output_dir("toy", file)
+    t0 = time.perf_counter()
+    with pytest.raises(SystemExit) as exc:
+        _cli.main(study_toy, ["--out", str(file), "--sleep", "5"])
+    assert exc.value.code == 2 and time.perf_counter() - t0 < 2.0     # at once, not after the runs
+    assert "existing file" in capsys.readouterr().err
+    monkeypatch.chdir(tmp_path)
+    assert output_dir("toy", quick=True) == Path("out/toy-quick")     # quick never overwrites the full results
+    assert output_dir("toy") == Path("out/toy")
+    with pytest.raises(ValueError, match="unique labels"):
+        run_cases(calls.append, [Case(label="a"), Case(label="a")])
+
+
+def test_cli_help_states_the_defaults(capsys):
+    with pytest.raises(SystemExit):
+        _cli.main(study_toy, ["--help"])
+    text = " ".join(capsys.readouterr().out.split()).replace("- ", "-")     # argparse wraps at hyphens
+    assert "number of cases (default: 4; with --quick: 2)" in text and "out/toy-quick" in text
+
+
+def _interrupt(tmp_path, jobs):
+    """Start the toy study in its own session, Ctrl-C (SIGINT to the group) once 2 cases are stored."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(HERE), str(ROOT)]), TOY_SLOW_FROM="2")
+    args = [sys.executable, "-c", _MAIN, "--out", str(tmp_path), "--sleep", "0.1"]
+    if jobs:
+        args += ["--jobs", str(jobs)]
+    proc = subprocess.Popen(args, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    deadline = time.monotonic() + 120
+    while len(list((tmp_path / "cases").glob("*.json"))) < 2:
+        assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
+        time.sleep(0.1)
+    time.sleep(0.5)                                   # the slow cases are running now
+    t0 = time.monotonic()
+    os.killpg(proc.pid, signal.SIGINT)
+    out, err = proc.communicate(timeout=30)
+    return proc.returncode, time.monotonic() - t0, err
+
+
+def _alive(pid):
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return False
+    return "zombie" not in status
+
+
+@pytest.mark.parametrize("jobs", [None, 2])
+def test_ctrl_c_stops_within_seconds_keeps_finished_cases_and_exits_130(tmp_path, jobs):
+    code, seconds, err = _interrupt(tmp_path, jobs)
+    assert code == 130 and seconds < 10.0, (code, seconds, err)
+    assert "Traceback" not in err
+    last = [line for line in err.replace("\r", "\n").splitlines() if line.strip()][-1]
+    assert "interrupted: 2 of 4 cases finished and kept" in last
+    workers = [int(p.name) for p in (tmp_path / "pids").iterdir()]
+    time.sleep(0.5)
+    assert not any(_alive(pid) for pid in workers), "a worker outlived Ctrl-C"
+    # the same command again reuses the two finished cases and runs the other two
+    again = subprocess.run([sys.executable, "-c", _MAIN, "--out", str(tmp_path), "--sleep", "0.1"],
+                           env=dict(os.environ, PYTHONPATH=os.pathsep.join([str(HERE), str(ROOT)])),
+                           capture_output=True, text=True, timeout=120)
+    assert again.returncode == 0 and "reusing 2 of 4 finished cases" in again.stderr, again.stderr
+    assert "| case 3 | 9 |" in again.stdout
