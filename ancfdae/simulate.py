@@ -1,4 +1,4 @@
-"""``simulate``: the one front door to the integrators (design.md Sect. 2, 5).
+"""``simulate``: the one front door to the integrators.
 
 Imitates scipy's ``solve_ivp``: a ``METHODS`` registry, options forwarded to
 the integrator, and a :class:`~ancfdae.result.Result` that reports failure in

@@ -1,7 +1,7 @@
-"""Energy drift in long free motion: every element x integrator pair (design.md Sect. 1, chapter Sect. 5.3).
+"""Energy drift in long free motion: every element x integrator pair (chapter Sect. 5.3).
 
 The planar elements fly as in B2 (force and moment pulse, ends at 2.5 s), the
-spatial ones as in B3 (moment hat, ends at 3 s), both from benchmarks.md;
+spatial ones as in B3 (moment hat, ends at 3 s), both as the project defines them;
 after the load the motion is free and the total energy ``T + U`` of the exact
 solution is constant. Each element type is integrated by Lobatto IIIA (3 and
 2 stages, modified Newton), Newmark (beta 1/4, gamma 1/2), HHT (alpha 0.05),

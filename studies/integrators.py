@@ -1,6 +1,6 @@
-"""Integrators compared on B2: work-precision, Newton work per step, energy drift (design.md Sect. 1).
+"""Integrators compared on B2: work-precision, Newton work per step, energy drift.
 
-The B2 beam (benchmarks.md; a small mesh of BE2D) and a stiffer variant
+The B2 beam (the project's definition; a small mesh of BE2D) and a stiffer variant
 (Young's modulus x 100: its axial and bending frequencies x 10) are integrated
 over [0, T] by Lobatto IIIA with 3 and 2 stages (modified and full Newton),
 Newmark (beta 1/4, gamma 1/2), HHT (alpha 0.05), generalized-alpha
@@ -18,7 +18,7 @@ over the run (the work of the loads integrated along, see EnergyMonitor) and
 the drift after the pulse; per method the observed order (log-log fit of
 eps_T against h).
 
-IDA runs set ``OMP_NUM_THREADS=1`` (notes/ida.md); set it in the shell
+IDA runs set ``OMP_NUM_THREADS=1`` (measured: with a busy second core the bundled OpenMP threads made IDA's solvers several times slower); set it in the shell
 before the study starts to be sure it takes effect.
 
 Run: ``ancfdae study integrators [--quick] [--out DIR] [--jobs N]``.

@@ -1,4 +1,4 @@
-"""Interchangeable time integrators; each consumes only the Model contract (design.md Sect. 5).
+"""Interchangeable time integrators; each consumes only the Model contract.
 
 Fixed step: :class:`LobattoIIIA` (2 or 3 stages), :class:`Newmark`, :class:`HHTAlpha`,
 :class:`GeneralizedAlpha`, :class:`EnergyMomentum` (discrete-gradient midpoint rule: energy and

@@ -1,6 +1,6 @@
 """Beam: mesh + element + supports + loads, assembled into a :class:`ancfdae.problem.Model`.
 
-The beam eliminates the fixed coordinates of its supports (design.md Sect. 3),
+The beam eliminates the fixed coordinates of its supports (every remaining coordinate is free),
 numbers the nodes along the axis (banded matrices) and assembles the element
 kernels of :mod:`ancfdae.models._element` into CSR matrices whose pattern is
 fixed at construction: K, D and M share one pattern, so an integrator forms
