@@ -50,13 +50,15 @@ def measure(model, t_load, method, h, t_end):
     L = np.array([[(M @ v) @ (Ak @ q) for Ak in A] for q, v in zip(res.q[after], res.v[after])])
     st = res.stats
     steps = max(st.get("steps", 1), 1)
+    nan = float("nan")
+    scale = max(float(np.abs(M @ res.v[-1]).sum()), 1e-300)
     return dict(status=res.status, t_end=float(res.t[-1]) if res.t.size else 0.0, steps=steps, wall=wall,
                 ms_step=1e3 * wall / steps, it_step=st.get("newton_iterations", 0) / steps,
                 fact=st.get("factorizations", 0),
-                dE=float(np.max(np.abs(E - E[0])) / abs(E[0])) if E.size else float("nan"), E0=float(E[0]) if E.size else float("nan"),
-                dp=float(np.max(np.abs(p - p[0]))) / max(float(np.abs(M @ res.v[-1]).sum()), 1e-300) if p.size else float("nan"),
-                dL=float(np.max(np.abs(L - L[0])) / np.abs(L[0]).max()) if L.size else float("nan"))
-
+                dE=float(np.max(np.abs(E - E[0])) / abs(E[0])) if E.size else nan,
+                E0=float(E[0]) if E.size else nan,
+                dp=float(np.max(np.abs(p - p[0]))) / scale if p.size else nan,
+                dL=float(np.max(np.abs(L - L[0])) / np.abs(L[0]).max()) if L.size else nan)
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -83,7 +85,8 @@ def main(argv=None):
         r["wall"] = float(np.median([x["wall"] for x in rs]))
         r["ms_step"] = 1e3 * r["wall"] / r["steps"]
         print(f"{m:18s} {r['status']:8s} {r['steps']:6d} {r['wall']:8.1f} {r['ms_step']:8.2f} {r['it_step']:7.2f} "
-              f"{r['fact']:5d} {r['dE']:9.2e} {r['dp']:9.2e} {r['dL']:9.2e}   (E = {r['E0']:.6g} J, t = {r['t_end']:g})")
+              f"{r['fact']:5d} {r['dE']:9.2e} {r['dp']:9.2e} {r['dL']:9.2e}   "
+              f"(E = {r['E0']:.6g} J, t = {r['t_end']:g})")
 
 
 if __name__ == "__main__":

@@ -231,6 +231,8 @@ class EnergyMomentum(FixedStepIntegrator):
         v1 = v0 + (2.0 / h) * y
         # The acceleration at t1 (for interpolation and the next predictor): M a1 = -r(t1, q1, v1, 0).
         a1 = self._Mlu.solve(-np.asarray(self._residual(t1, q1, v1, np.zeros_like(q1)), dtype=float))
+        if not np.all(np.isfinite(a1)):
+            return False, f"the acceleration at t = {t1:.9g} is not finite (the model's residual there)"
         quad = None
         if self.want_quadrature:
             # The scheme's own rule: midpoint state, velocity (q1 - q0)/h, weight h.
