@@ -12,7 +12,7 @@ import inspect
 import sys
 from dataclasses import dataclass
 
-from ._common import Interrupted
+from ._common import Interrupted, OptionError
 
 __all__ = ["Option", "parser", "main"]
 
@@ -73,7 +73,7 @@ def main(module, argv=None, prog: str | None = None) -> int:
     except KeyboardInterrupt:
         print(f"{p.prog} interrupted.", file=sys.stderr)
         return 130
-    except ValueError as exc:           # bad options (e.g. --out an existing file): said at once
+    except OptionError as exc:          # bad options (e.g. --out an existing file): said at once, before any work
         p.error(str(exc))
     if result.get("table"):
         print(result["table"])
