@@ -46,3 +46,14 @@ def choice(name: str, value, options) -> str:
     if value not in options:
         raise ValueError(f"`{name}` must be one of {sorted(options)}, got {value!r}.")
     return value
+
+
+def check_shape(name: str, value, shape: tuple, what: str = "") -> None:
+    """Raise ValueError unless ``np.shape(value) == shape`` (a shape comparison, no copy).
+
+    ``what`` says where the expected shape comes from, e.g. ``"n_dof = 16"``.
+    """
+    got = np.shape(value)
+    if got != shape:
+        why = f" ({what})" if what else ""
+        raise ValueError(f"`{name}` must have shape {shape}{why}, got {got}.")

@@ -1,4 +1,15 @@
-"""The ``ancfdae`` command: ``ancfdae study NAME [options]``, ``ancfdae studies``."""
+"""The ``ancfdae`` command.
+
+``ancfdae study NAME [options]`` runs a study, ``ancfdae studies`` lists them,
+``ancfdae export vtk RESULT DIR`` writes ParaView files of a result file,
+``ancfdae animate RESULT OUT.gif`` an animation, ``ancfdae --version``.
+``python -m ancfdae`` is the same command.
+
+The result files carry the description of their beam (element, material,
+section, mesh, supports), so the export and the animation rebuild the beam from
+the file alone: a user holding only ``result.nc`` gets the pictures, with no
+script to find and no ``--model`` argument to get right.
+"""
 from __future__ import annotations
 
 import argparse
@@ -21,16 +32,83 @@ def _load(name: str):
     return importlib.import_module(f"ancfdae.studies.{name}")
 
 
-def main(argv=None) -> int:
-    """Entry point of the console script."""
-    parser = argparse.ArgumentParser(prog="ancfdae", description="ANCF beam dynamics: run the studies.")
+def _load_result(path: str):
+    from ancfdae.result import Result, ResultFileError
+    try:
+        return Result.load(path)
+    except ResultFileError as exc:
+        raise SystemExit(f"ancfdae: {exc}") from None
+
+
+def _positive(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a positive integer, got {value}")
+    return value
+
+
+def _export(args) -> int:
+    from ancfdae.export import vtk
+    result = _load_result(args.result)
+    try:
+        pvd = vtk(result, None, args.directory, name=args.name, every=args.every)
+    except ValueError as exc:
+        raise SystemExit(f"ancfdae: {args.result}: {exc}") from None
+    print(f"ParaView time series written to {pvd}")
+    return 0
+
+
+def _animate(args) -> int:
+    from ancfdae.plot import animate
+    result = _load_result(args.result)
+    try:
+        out = animate(result, args.output, every=args.every, fps=args.fps)
+    except ValueError as exc:
+        raise SystemExit(f"ancfdae: {args.result}: {exc}") from None
+    print(f"animation written to {out}")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the console script and of ``python -m ancfdae``.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Arguments (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        Exit status 0; errors exit through :class:`SystemExit` with a message.
+    """
+    from ancfdae import __version__
+    parser = argparse.ArgumentParser(prog="ancfdae", description="ANCF beam dynamics: studies, result files, "
+                                     "ParaView export and animations.")
+    parser.add_argument("--version", action="version", version=f"ancfdae {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     st = sub.add_parser("study", help="run a study (see `ancfdae study NAME --help` for its options)",
                         add_help=False)
     st.add_argument("name", help="study name (see `ancfdae studies`)")
     st.add_argument("options", nargs=argparse.REMAINDER, help="the study's options")
     sub.add_parser("studies", help="list the studies")
+    ex = sub.add_parser("export", help="export a result file (ParaView)")
+    ex_sub = ex.add_subparsers(dest="format", required=True)
+    vt = ex_sub.add_parser("vtk", help="write NAME.pvd + .vtu files of the beam as a solid")
+    vt.add_argument("result", help="result file written by Result.save (.nc)")
+    vt.add_argument("directory", help="output folder (created if missing)")
+    vt.add_argument("--name", default="beam", help="base name of the files (default beam)")
+    vt.add_argument("--every", type=_positive, default=1, help="write every N-th output (default 1)")
+    an = sub.add_parser("animate", help="write an animated GIF of a result file")
+    an.add_argument("result", help="result file written by Result.save (.nc)")
+    an.add_argument("output", help="the .gif file to write")
+    an.add_argument("--every", type=_positive, default=1, help="draw every N-th output (default 1)")
+    an.add_argument("--fps", type=_positive, default=20, help="frames per second (default 20)")
     args = parser.parse_args(argv)
+    if args.command == "export":
+        return _export(args)
+    if args.command == "animate":
+        return _animate(args)
     if args.command == "studies":
         for name in _studies():
             doc = (_load(name).__doc__ or "").strip().splitlines()

@@ -42,24 +42,72 @@ TimeFunction = Callable[[float], float]
 
 
 def constant(value: float = 1.0) -> TimeFunction:
-    """Time function equal to ``value`` for all t."""
+    """Time function equal to ``value`` for all t.
+
+    Parameters
+    ----------
+    value : float
+
+    Returns
+    -------
+    callable
+        ``time(t) -> float``.
+    """
     return lambda t: value
 
 
 def ramp(t_end: float) -> TimeFunction:
-    """``t / t_end`` up to ``t_end``, then 1."""
+    """Time function ``t / t_end`` up to ``t_end``, then 1.
+
+    Parameters
+    ----------
+    t_end : float
+        End of the ramp (> 0).
+
+    Returns
+    -------
+    callable
+        ``time(t) -> float``.
+    """
     t_end = positive("t_end", t_end)
     return lambda t: min(max(t / t_end, 0.0), 1.0)
 
 
 def pulse(T: float) -> TimeFunction:
-    """``(1 - cos(2 pi t / T)) / 2`` for ``0 <= t <= T``, 0 after (benchmarks.md B2)."""
+    """Time function ``(1 - cos(2 pi t / T)) / 2`` for ``0 <= t <= T``, 0 after.
+
+    The smooth load pulse that sets the flying beams of the chapter's
+    Sect. 5.2 in motion.
+
+    Parameters
+    ----------
+    T : float
+        Duration of the pulse (> 0).
+
+    Returns
+    -------
+    callable
+        ``time(t) -> float``.
+    """
     T = positive("T", T)
     return lambda t: 0.5 * (1.0 - np.cos(2.0 * np.pi * t / T)) if 0.0 <= t <= T else 0.0
 
 
 def hat(t_peak: float) -> TimeFunction:
-    """``t / t_peak`` up to ``t_peak``, down to 0 at ``2 t_peak``, 0 after (benchmarks.md B3)."""
+    """Time function ``t / t_peak`` up to ``t_peak``, down to 0 at ``2 t_peak``, 0 after.
+
+    The hat-shaped load history of the spatial flying beam (chapter Sect. 5.3).
+
+    Parameters
+    ----------
+    t_peak : float
+        Time of the peak (> 0).
+
+    Returns
+    -------
+    callable
+        ``time(t) -> float``.
+    """
     t_peak = positive("t_peak", t_peak)
 
     def f(t):
@@ -115,8 +163,18 @@ class PointForce:
 class PointMoment:
     """Dead moment at a node or at axis point ``s``.
 
-    ``moment`` is a scalar (about e_z) for planar elements or a 3-vector for
-    spatial ones. See the module docstring for how it acts on slopes.
+    It acts through the virtual rotation of the cross-section frame, computed
+    from the slopes (chapter Sect. 2.2); see the module docstring.
+
+    Parameters
+    ----------
+    moment : float or array_like, shape (3,)
+        A scalar (about e_z) for planar elements or a 3-vector for spatial ones.
+    node : int, optional
+    s : float, optional
+        Arc length along the undeformed axis.
+    time : callable, optional
+        Scale ``time(t)``; constant 1 if omitted.
     """
 
     moment: np.ndarray
@@ -140,7 +198,13 @@ class PointMoment:
 
 @dataclass(frozen=True)
 class Gravity:
-    """Uniform gravity field ``g`` (acceleration, shape (dim,)); conservative, constant in time."""
+    """Uniform gravity field; conservative, constant in time.
+
+    Parameters
+    ----------
+    g : array_like, shape (dim,)
+        Acceleration of gravity, e.g. ``(0, -9.81)``.
+    """
 
     g: np.ndarray
 
@@ -150,7 +214,15 @@ class Gravity:
 
 @dataclass(frozen=True)
 class DistributedLoad:
-    """Dead line load ``w`` (force per unit undeformed length) on the whole beam, scaled by ``time(t)``."""
+    """Dead line load on the whole beam.
+
+    Parameters
+    ----------
+    w : array_like, shape (dim,)
+        Force per unit undeformed length.
+    time : callable, optional
+        Scale ``time(t)``; constant 1 if omitted.
+    """
 
     w: np.ndarray
     time: TimeFunction | None = None

@@ -9,7 +9,10 @@ axis 3 (``int eta^2 dA``, bending in the (x, y) plane -- the planar case).
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field
+
+import numpy as np
 
 from ._validate import positive
 
@@ -19,7 +22,15 @@ __all__ = ["Material", "RectangularSection", "CircularSection", "cowper_shear_fa
 def cowper_shear_factor(nu: float) -> float:
     """Cowper's shear correction factor of a rectangle, chapter Eq. 112.
 
-    ``k_s = 10 (1 + nu) / (12 + 11 nu)``; 0.8496732026143791 for nu = 0.3.
+    Parameters
+    ----------
+    nu : float
+        Poisson's ratio.
+
+    Returns
+    -------
+    float
+        ``k_s = 10 (1 + nu) / (12 + 11 nu)``; 0.8496732026143791 for nu = 0.3.
     """
     return 10.0 * (1.0 + nu) / (12.0 + 11.0 * nu)
 
@@ -43,15 +54,49 @@ class Material:
     rho: float
 
     def __post_init__(self):
-        positive("E", self.E)
-        positive("rho", self.rho)
-        if not (isinstance(self.nu, (int, float)) and 0.0 <= self.nu < 0.5):
-            raise ValueError(f"`nu` must be a number in [0, 0.5), got {self.nu!r}.")
+        # Stored as Python floats: numpy scalars (np.float32(0.3)) are numbers too, and a float32
+        # kept as is would carry single precision into every stiffness computed from it.
+        object.__setattr__(self, "E", positive("E", self.E))
+        object.__setattr__(self, "rho", positive("rho", self.rho))
+        nu = self.nu
+        if (isinstance(nu, bool) or not isinstance(nu, numbers.Real) or not np.isfinite(nu)
+                or not 0.0 <= nu < 0.5):
+            raise ValueError(f"`nu` must be a number in [0, 0.5), got {nu!r}.")
+        object.__setattr__(self, "nu", float(nu))
 
     @property
     def G(self) -> float:
         """Shear modulus ``E / (2 (1 + nu))`` (chapter Eq. 112)."""
         return self.E / (2.0 * (1.0 + self.nu))
+
+
+def _check_factors(section) -> None:
+    """Validate ``shear_factor``, ``torsion_factor`` and ``shear_factors`` of a section (frozen dataclass)."""
+    for name in ("shear_factor", "torsion_factor"):   # stored as floats (numpy scalars are numbers)
+        value = getattr(section, name)
+        if value is not None:
+            object.__setattr__(section, name, positive(name, value))
+    pair = section.shear_factors
+    if pair is None:
+        return
+    if section.shear_factor is not None:
+        raise ValueError("give either `shear_factor` (k2 = k3) or `shear_factors` (k2, k3), not both; got "
+                         f"shear_factor={section.shear_factor!r}, shear_factors={pair!r}.")
+    if isinstance(pair, (str, bytes)) or not hasattr(pair, "__len__") or len(pair) != 2:
+        raise ValueError(f"`shear_factors` must be a pair (k2, k3) of positive numbers, got {pair!r}.")
+    object.__setattr__(section, "shear_factors",
+                       (positive("shear_factors[0]", pair[0]), positive("shear_factors[1]", pair[1])))
+
+
+def _common_shear_factor(section, default: float) -> float:
+    """``k_s`` when k2 = k3; a clear error when the section has two different factors."""
+    if section.shear_factors is not None:
+        k2, k3 = section.shear_factors
+        if k2 != k3:
+            raise ValueError(f"this section has two shear factors, shear_factors={section.shear_factors!r}; "
+                             "use `shear_factors_of(material)` instead of `k_s`.")
+        return k2
+    return section.shear_factor if section.shear_factor is not None else default
 
 
 def _saint_venant_rectangle(h: float, b: float, terms: int = 50) -> float:
@@ -70,27 +115,33 @@ class RectangularSection:
     h, b : float
         Side lengths (> 0); ``b`` defaults to ``h`` (square).
     shear_factor : float, optional
-        Shear correction factor ``k_s`` used for ``k2`` and ``k3``; None
-        selects Cowper's value of chapter Eq. 112 for the material's ``nu``.
+        One shear correction factor ``k_s`` for both transverse shears
+        (``k2 = k3 = k_s``); None selects Cowper's value of chapter Eq. 112 for
+        the material's ``nu``.
     torsion_factor : float, optional
         ``k_t`` such that the torsional rigidity is ``G J k_t`` with
-        ``J = I2 + I3``; None selects the Saint-Venant value (0.8436 for a square).
+        ``J = I2 + I3``; None selects the Saint-Venant value (0.8436 for a
+        square). Nachbagauer et al. (2013) call it ``k1`` (0.5768 for their
+        0.2 x 0.4 section).
+    shear_factors : (float, float), optional
+        ``(k2, k3)``: separate factors for the shear along ``eta`` (``Gamma_2``,
+        stiffness ``k2 G A``) and along ``zeta`` (``Gamma_3``, ``k3 G A``),
+        chapter Eq. 42; e.g. ``(0.8331, 0.7961)`` in Nachbagauer et al. (2013).
+        Not together with ``shear_factor``. The planar elements use ``k2``.
     """
 
     h: float
     b: float | None = None
     shear_factor: float | None = None
     torsion_factor: float | None = None
+    shear_factors: tuple | None = None
 
     def __post_init__(self):
-        positive("h", self.h)
+        object.__setattr__(self, "h", positive("h", self.h))
         if self.b is None:
-            object.__setattr__(self, "b", float(self.h))
-        positive("b", self.b)
-        if self.shear_factor is not None:
-            positive("shear_factor", self.shear_factor)
-        if self.torsion_factor is not None:
-            positive("torsion_factor", self.torsion_factor)
+            object.__setattr__(self, "b", self.h)
+        object.__setattr__(self, "b", positive("b", self.b))
+        _check_factors(self)
 
     @property
     def A(self) -> float:
@@ -118,8 +169,15 @@ class RectangularSection:
         return self.I2 + self.I3
 
     def k_s(self, material: Material) -> float:
-        """Shear correction factor (Cowper's by default)."""
-        return self.shear_factor if self.shear_factor is not None else cowper_shear_factor(material.nu)
+        """The common shear correction factor (Cowper's by default); see :meth:`shear_factors_of`."""
+        return _common_shear_factor(self, cowper_shear_factor(material.nu))
+
+    def shear_factors_of(self, material: Material) -> tuple[float, float]:
+        """``(k2, k3)``: the shear factors along ``eta`` and ``zeta`` (chapter Eq. 42)."""
+        if self.shear_factors is not None:
+            return self.shear_factors
+        k = self.k_s(material)
+        return k, k
 
     @property
     def k_t(self) -> float:
@@ -131,29 +189,46 @@ class RectangularSection:
 
 @dataclass(frozen=True)
 class CircularSection:
-    """Solid circular cross-section of diameter ``d``.
+    """Solid circular cross-section.
 
     ``k_t = 1`` (the polar moment is the torsion constant); the default shear
     factor is ``6 (1 + nu) / (7 + 6 nu)`` (Cowper, solid circle).
+
+    Parameters
+    ----------
+    d : float
+        Diameter (> 0).
+    shear_factor : float, optional
+        Shear correction factor ``k_s`` (k2 = k3); None selects Cowper's.
+    torsion_factor : float, optional
+        ``k_t``; None selects 1.
+    shear_factors : (float, float), optional
+        ``(k2, k3)`` along ``eta`` and ``zeta`` instead of one ``shear_factor``
+        (as for :class:`RectangularSection`).
     """
 
     d: float
     shear_factor: float | None = None
     torsion_factor: float | None = None
+    shear_factors: tuple | None = None
 
     def __post_init__(self):
-        positive("d", self.d)
+        object.__setattr__(self, "d", positive("d", self.d))
+        _check_factors(self)
 
     @property
     def A(self) -> float:
+        """Area ``pi d^2 / 4``."""
         return math.pi * self.d**2 / 4.0
 
     @property
     def I2(self) -> float:
+        """``int zeta^2 dA = pi d^4 / 64``."""
         return math.pi * self.d**4 / 64.0
 
     @property
     def I3(self) -> float:
+        """``int eta^2 dA``, equal to ``I2``."""
         return self.I2
 
     @property
@@ -163,13 +238,31 @@ class CircularSection:
 
     @property
     def J(self) -> float:
+        """Polar moment ``I2 + I3``."""
         return self.I2 + self.I3
 
     def k_s(self, material: Material) -> float:
-        if self.shear_factor is not None:
-            return self.shear_factor
-        return 6.0 * (1.0 + material.nu) / (7.0 + 6.0 * material.nu)
+        """The common shear correction factor (Cowper's for a solid circle by default).
+
+        Parameters
+        ----------
+        material : Material
+            Its ``nu`` enters Cowper's factor.
+
+        Returns
+        -------
+        float
+        """
+        return _common_shear_factor(self, 6.0 * (1.0 + material.nu) / (7.0 + 6.0 * material.nu))
+
+    def shear_factors_of(self, material: Material) -> tuple[float, float]:
+        """``(k2, k3)``: the shear factors along ``eta`` and ``zeta`` (chapter Eq. 42)."""
+        if self.shear_factors is not None:
+            return self.shear_factors
+        k = self.k_s(material)
+        return k, k
 
     @property
     def k_t(self) -> float:
+        """Torsion factor: 1 for a solid circle (the polar moment is the torsion constant)."""
         return 1.0 if self.torsion_factor is None else self.torsion_factor

@@ -1,16 +1,20 @@
-"""Monitors: energy balance and point sensors, logged at the output times (design.md Sect. 6).
+"""Monitors: energy balance and point sensors, logged at the output times.
 
 Every integrator drives a monitor through four calls:
 
 ``start(model, t0, q0, v0, a0)``
     once, before the first step;
 ``advance(t, q, v, a, nodes=None)``
-    after every accepted step (on IDA: every internal step), with an
-    optional quadrature of the step, ``nodes = (ts, Q, V, w)`` (times, stage
-    coordinates and velocities as rows, weights that sum to the step size),
-    for integrals over the step;
+    after every accepted step (on IDA: every internal step), with the
+    step's quadrature when the integrator has one, an
+    :class:`ancfdae.integrators.protocol.Quadrature` ``(t, q, v, w)`` (node
+    times, coordinates and velocities as rows, weights that sum to the step
+    size), for integrals over the step;
 ``sample(t, q, v, a)``
     at every output time (``t`` lies in the last advanced step);
+``rebind(model)`` (optional)
+    after a model event (BE3D's director update) with the model bound to
+    the new event state, so that later evaluations use it;
 ``log()``
     the arrays (one entry per output time) and scalars stored in
     ``Result.monitors[name]``.
@@ -18,6 +22,8 @@ Every integrator drives a monitor through four calls:
 ``stop_reason()`` returns a string when the monitor asks the run to end.
 """
 from __future__ import annotations
+
+from typing import Any, Callable
 
 import numpy as np
 
@@ -31,24 +37,70 @@ class Monitor:
 
     name = "monitor"
 
-    def start(self, model, t, q, v, a) -> None:  # noqa: D102
+    def start(self, model: Any, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> None:
+        """Begin a run: the model and the initial state.
+
+        Parameters
+        ----------
+        model : Model
+        t : float
+        q, v, a : ndarray, shape (n_dof,)
+        """
         self.model = model
 
-    def advance(self, t, q, v, a, nodes=None) -> None:  # noqa: D102
-        pass
+    def advance(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, nodes: tuple | None = None) -> None:
+        """Account for one accepted step ending at ``t``.
 
-    def sample(self, t, q, v, a) -> None:  # noqa: D102
-        pass
+        Parameters
+        ----------
+        t : float
+        q, v, a : ndarray, shape (n_dof,)
+            State at the end of the step.
+        nodes : tuple, optional
+            ``(ts, Q, V, w)``: the step's quadrature (times, stage coordinates
+            and velocities as rows, weights summing to the step size).
+        """
 
-    def log(self) -> dict:  # noqa: D102
+    def rebind(self, model: Any) -> None:
+        """Use ``model`` (bound to a new event state) from now on.
+
+        Parameters
+        ----------
+        model : Model
+        """
+        self.model = model
+
+    def sample(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> None:
+        """Record the state at an output time (inside the last advanced step).
+
+        Parameters
+        ----------
+        t : float
+        q, v, a : ndarray, shape (n_dof,)
+        """
+
+    def log(self) -> dict:
+        """The recorded data: arrays with one entry per output time, and scalars.
+
+        Returns
+        -------
+        dict
+            Stored as ``Result.monitors[name]``.
+        """
         return {}
 
-    def stop_reason(self) -> str | None:  # noqa: D102
+    def stop_reason(self) -> str | None:
+        """A message when the monitor asks the run to end, else None.
+
+        Returns
+        -------
+        str or None
+        """
         return None
 
 
 class EnergyMonitor(Monitor):
-    """Energy balance ``E(t) = T + U + V - W_ext`` (design.md Sect. 6).
+    """Energy balance ``E(t) = T + U + V - W_ext`` logged at the output times.
 
     ``T, U, V`` come from ``model.energy`` (kinetic, strain, potential of the
     conservative loads). ``W_ext(t) = int_t0^t P_ext dt`` is the work of the
@@ -85,7 +137,7 @@ class EnergyMonitor(Monitor):
             raise ValueError(f"`stop_on_blowup` must be True or False, got {stop_on_blowup!r}.")
         self.stop_on_blowup = stop_on_blowup
 
-    def start(self, model, t, q, v, a):
+    def start(self, model: Any, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> None:
         for attr in ("energy", "external_power"):
             if not callable(getattr(model, attr, None)):
                 raise TypeError(f"EnergyMonitor needs `model.{attr}(t, q, v)`; "
@@ -100,7 +152,7 @@ class EnergyMonitor(Monitor):
         self._e0 = None
         self._blow = None
 
-    def advance(self, t, q, v, a, nodes=None):
+    def advance(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, nodes: tuple | None = None) -> None:
         p_end = float(self.model.external_power(t, q, v))
         if nodes is None:
             dw = 0.5 * (t - self._t_cur) * (self._p_cur + p_end)
@@ -116,7 +168,7 @@ class EnergyMonitor(Monitor):
         theta = (t - self._t_prev) / (self._t_cur - self._t_prev)
         return self._w_prev + theta * (self._w_cur - self._w_prev)
 
-    def sample(self, t, q, v, a):
+    def sample(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> None:
         e = self.model.energy(t, q, v)
         w = self._work_at(float(t))
         total = e.kinetic + e.strain + e.potential
@@ -129,12 +181,12 @@ class EnergyMonitor(Monitor):
             self._blow = float(t)
         self._rows.append((e.kinetic, e.strain, e.potential, w, total, balance, drift))
 
-    def stop_reason(self):
+    def stop_reason(self) -> str | None:
         if self.stop_on_blowup and self._blow is not None:
             return f"energy blow-up detected at t = {self._blow:.6g} by monitor {self.name!r}"
         return None
 
-    def log(self):
+    def log(self) -> dict:
         rows = np.array(self._rows, dtype=float).reshape(-1, 7)
         keys = ("kinetic", "strain", "potential", "work", "total", "balance", "drift")
         out = {k: rows[:, i].copy() for i, k in enumerate(keys)}
@@ -164,7 +216,8 @@ class PointSensor(Monitor):
     velocity_function : callable, optional
     """
 
-    def __init__(self, s=None, *, function=None, name=None, velocity_function=None):
+    def __init__(self, s: float | None = None, *, function: Callable | None = None, name: str | None = None,
+                 velocity_function: Callable | None = None):
         if (s is None) == (function is None):
             raise ValueError("PointSensor needs exactly one of `s` (arc length) or `function`, "
                              f"got s={s!r}, function={function!r}.")
@@ -177,14 +230,14 @@ class PointSensor(Monitor):
         self.s, self.function, self.velocity_function = s, function, velocity_function
         self.name = name if name is not None else (f"point@{s:g}" if s is not None else "point")
 
-    def start(self, model, t, q, v, a):
+    def start(self, model: Any, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> None:
         if self.s is not None and not callable(getattr(model, "position", None)):
             raise TypeError(f"PointSensor(s=...) needs `model.position(q, s)`; {type(model).__name__} has "
                             "none: pass `function=` instead.")
         self.model = model
         self._pos, self._vel = [], []
 
-    def sample(self, t, q, v, a):
+    def sample(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> None:
         if self.s is not None:
             p = np.asarray(self.model.position(q, self.s), dtype=float)
             self._pos.append(p)
@@ -194,7 +247,7 @@ class PointSensor(Monitor):
             if self.velocity_function is not None:
                 self._vel.append(np.atleast_1d(np.asarray(self.velocity_function(q, v), dtype=float)))
 
-    def log(self):
+    def log(self) -> dict:
         out = {"position": np.array(self._pos)}
         if self._vel:
             out["velocity"] = np.array(self._vel)
@@ -204,19 +257,27 @@ class PointSensor(Monitor):
 
 
 class Probe(Monitor):
-    """Any quantity ``function(t, q, v, a) -> array`` logged at the output times."""
+    """Any quantity logged at the output times.
 
-    def __init__(self, name: str, function):
+    Parameters
+    ----------
+    name : str
+        Key in ``Result.monitors``.
+    function : callable
+        ``function(t, q, v, a) -> array``, logged as ``"value"``.
+    """
+
+    def __init__(self, name: str, function: Callable):
         if not callable(function):
             raise ValueError(f"`function` must be callable, got {function!r}.")
         self.name, self.function = str(name), function
 
-    def start(self, model, t, q, v, a):
+    def start(self, model: Any, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> None:
         self.model = model
         self._rows = []
 
-    def sample(self, t, q, v, a):
+    def sample(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> None:
         self._rows.append(np.asarray(self.function(t, q, v, a), dtype=float))
 
-    def log(self):
+    def log(self) -> dict:
         return {"value": np.array(self._rows)}

@@ -1,4 +1,4 @@
-"""The contract between models and integrators (design.md Sect. 3).
+"""The contract between models and integrators.
 
 A *Model* is the semi-discrete equation of motion in residual form, with the
 boundary conditions already applied (fixed coordinates eliminated)::
@@ -9,13 +9,14 @@ Integrators -- ours and a user's own -- need nothing but this protocol.
 """
 from __future__ import annotations
 
+import inspect
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["Model", "JacobianBlocks", "Energy"]
+__all__ = ["Model", "JacobianBlocks", "Energy", "CAPABILITIES", "capabilities"]
 
 
 @dataclass(frozen=True)
@@ -94,14 +95,9 @@ class Model(Protocol):
     Notes
     -----
     ``jacobian`` must be exact (analytic or automatic differentiation),
-    never finite differences at run time. Models may also provide
-    ``accept_step(t, q, v) -> (q, v)``, a hook that integrators and the
-    static solver call after every accepted step (BE3D's director update
-    uses it); it must leave the physical configuration unchanged at the
-    nodes. Optional fast paths that solvers use when present:
-    ``residual_jacobian(t, q, v, a) -> (r, JacobianBlocks)`` (one kernel
-    pass; full Newton) and ``residual_stages(ts, Q, V, A) -> (n_dof, m)``
-    (all implicit stages of a Runge-Kutta step in one pass; Lobatto IIIA).
+    never finite differences at run time. What a model offers beyond this
+    contract it declares in ``capabilities`` (see :data:`CAPABILITIES` and
+    :func:`capabilities`); solvers use nothing undeclared.
     """
 
     n_dof: int
@@ -132,9 +128,64 @@ class Model(Protocol):
         ...
 
 
-def accept_step(model, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Call the model's optional ``accept_step`` hook; identity when absent."""
-    hook = getattr(model, "accept_step", None)
-    if hook is None:
-        return q, v
-    return hook(t, q, v)
+#: Optional capabilities a model may declare in its ``capabilities`` attribute (a set of these names),
+#: each with the methods it promises. Solvers use a capability only when it is declared.
+#:
+#: ``"residual_jacobian"``
+#:     ``residual_jacobian(t, q, v, a) -> (r, JacobianBlocks)``: both from one kernel pass (full Newton,
+#:     the static solver).
+#: ``"residual_stages"``
+#:     ``residual_stages(ts, Q, V, A) -> R`` with columns = stages, shape ``(n_dof, m)``: all implicit
+#:     stages of a Runge-Kutta step in one call (Lobatto IIIA).
+#: ``"variable_mass"``
+#:     ``M`` depends on ``q`` (then ``mass_is_constant`` must be False); no extra method.
+#: ``"step_events"``
+#:     the model has an *event state* (a dict of arrays, e.g. BE3D's nodal directors) that may change
+#:     between steps: ``event_state() -> dict`` (the initial state), ``bind(state) -> Model`` (a model
+#:     evaluating with that state and sharing everything else; cheap; the original is never changed) and
+#:     ``step_event(t, q, v) -> None or (q, v, state)`` called after every accepted step, None meaning
+#:     nothing changed. The driver carries the state, restarts the integrator when it changes and
+#:     stores it in ``Result.model_state``.
+CAPABILITIES: dict[str, tuple[str, ...]] = {
+    "residual_jacobian": ("residual_jacobian",),
+    "residual_stages": ("residual_stages",),
+    "variable_mass": (),
+    "step_events": ("event_state", "bind", "step_event"),
+}
+
+
+def capabilities(model) -> frozenset:
+    """The optional capabilities ``model`` declares, checked; empty when it declares none.
+
+    The declaration is looked up without ``__getattr__`` (:func:`inspect.getattr_static`), so a
+    wrapper that forwards attributes to the model it wraps does not inherit the wrapped model's
+    fast paths by accident -- it falls back to the plain contract unless it declares (and thereby
+    forwards) them deliberately.
+
+    Raises
+    ------
+    TypeError
+        When the declaration is not a collection of strings, names an unknown capability, or a
+        declared capability's methods are not callable.
+    """
+    try:
+        inspect.getattr_static(model, "capabilities")
+    except AttributeError:
+        return frozenset()
+    declared = model.capabilities
+    if isinstance(declared, str) or not all(isinstance(c, str) for c in declared):
+        raise TypeError(f"`{type(model).__name__}.capabilities` must be a set of capability names "
+                        f"{sorted(CAPABILITIES)}, got {declared!r}.")
+    declared = frozenset(declared)
+    unknown = sorted(declared - set(CAPABILITIES))
+    if unknown:
+        raise TypeError(f"`{type(model).__name__}.capabilities` names unknown capabilities {unknown}; "
+                        f"known: {sorted(CAPABILITIES)}.")
+    for cap in declared:
+        missing = [m for m in CAPABILITIES[cap] if not callable(getattr(model, m, None))]
+        if missing:
+            raise TypeError(f"{type(model).__name__} declares the capability {cap!r} but lacks the "
+                            f"callable(s) {missing}.")
+    if "variable_mass" in declared and getattr(model, "mass_is_constant", False):
+        raise TypeError(f"{type(model).__name__} declares 'variable_mass' but mass_is_constant is True.")
+    return declared

@@ -1,4 +1,4 @@
-"""The result of a simulation (design.md Sect. 6).
+"""The result of a simulation.
 
 Imitates scipy's ``OdeResult``: the front door never raises on a failed
 integration; it returns a :class:`Result` whose ``status`` says what happened
@@ -6,28 +6,22 @@ and which keeps every output sample up to the failure.
 """
 from __future__ import annotations
 
-import json
+import os
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Result"]
+from . import _resultfile
+from ._resultfile import ResultFileError
+
+if TYPE_CHECKING:
+    import xarray
+
+__all__ = ["Result", "ResultFileError"]
 
 _STATUSES = ("success", "failed")
-
-
-def _jsonable(obj):
-    """Convert numpy scalars (and containers of them) to plain Python for json."""
-    if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, np.generic):
-        return obj.item()
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    return obj
 
 
 @dataclass
@@ -55,6 +49,14 @@ class Result:
         Name of the integrator.
     options : dict
         The integrator's options (JSON-able), for the record.
+    model_state : dict
+        The model's event state at ``t`` (models with the ``"step_events"`` capability):
+        ``{name: ndarray of shape (n_out, ...)}``, e.g. BE3D's ``"directors"``, shape
+        ``(n_out, n_nodes, 3)``. Empty for models without event state.
+    model : dict
+        JSON-able description of the model (``model.describe()`` when it has
+        one, plus ``"dof_labels"``: ``{"node": [...], "coordinate": [...]}``);
+        empty when the model does not describe itself.
     """
 
     t: np.ndarray
@@ -68,6 +70,8 @@ class Result:
     t_fail: float | None = None
     method: str = ""
     options: dict = field(default_factory=dict)
+    model_state: dict = field(default_factory=dict)
+    model: dict = field(default_factory=dict)
 
     def __post_init__(self):
         if self.status not in _STATUSES:
@@ -81,6 +85,14 @@ class Result:
             if arr.ndim != 2 or arr.shape[0] != n:
                 raise ValueError(f"`{name}` must have shape ({n}, n_dof) to match `t`, got {arr.shape}.")
             setattr(self, name, arr)
+        state = {}
+        for key, arr in dict(self.model_state or {}).items():
+            arr = np.asarray(arr, dtype=float)
+            if arr.ndim < 1 or arr.shape[0] != n:
+                raise ValueError(f"`model_state[{key!r}]` must have {n} rows (one per output time), "
+                                 f"got shape {arr.shape}.")
+            state[str(key)] = arr
+        self.model_state = state
 
     @property
     def success(self) -> bool:
@@ -94,53 +106,43 @@ class Result:
                 f"n_dof={n_dof}, t={span}, message={self.message!r})")
 
     # -- persistence ------------------------------------------------------------------------
-    def save(self, path) -> Path:
-        """Write to ``path`` (``.npz`` added if missing): arrays plus JSON metadata.
+    def to_xarray(self) -> "xarray.Dataset":
+        """The result as a labelled :class:`xarray.Dataset` (what :meth:`save` writes).
 
-        Arrays go into the npz archive; status, message, stats, options and
-        scalar monitor entries into one JSON string stored in it as
-        ``"metadata"``, so a single file holds everything.
+        Dimensions ``time`` and ``dof`` with the coordinates ``node`` and
+        ``coordinate`` (e.g. ``x``, ``y'``, ``theta``) when the model described
+        itself; monitors and ``model_state`` arrays as variables; status,
+        message, stats, options and the model description as attributes.
         """
-        path = Path(path)
-        if path.suffix != ".npz":
-            path = path.with_name(path.name + ".npz")
-        arrays = {"t": self.t, "q": self.q, "v": self.v, "a": self.a}
-        scalars: dict = {}
-        for name, log in self.monitors.items():
-            if "/" in name:
-                raise ValueError(f"monitor names must not contain '/', got {name!r}.")
-            scalars[name] = {}
-            for key, value in log.items():
-                if isinstance(value, np.ndarray):
-                    arrays[f"monitor/{name}/{key}"] = value
-                else:
-                    scalars[name][key] = value
-        meta = {
-            "format": "ancfdae.Result/1",
-            "status": self.status,
-            "message": self.message,
-            "stats": self.stats,
-            "t_fail": self.t_fail,
-            "method": self.method,
-            "options": self.options,
-            "monitor_scalars": scalars,
-        }
-        arrays["metadata"] = np.array(json.dumps(_jsonable(meta)))
-        np.savez_compressed(path, **arrays)
-        return path
+        return _resultfile.to_dataset(self)
+
+    def save(self, path: str | os.PathLike, engine: str = _resultfile.ENGINE) -> Path:
+        """Write a self-describing NetCDF4/HDF5 file, readable by plain xarray or h5py.
+
+        Parameters
+        ----------
+        path : str or path-like
+            ``.nc`` is appended unless it ends in ``.nc``, ``.nc4`` or ``.h5``.
+        engine : {"netcdf4", "h5netcdf"}
+            xarray's writer; netCDF4 by default (measured 2-4 times faster
+            than h5netcdf with equal file sizes; see :mod:`ancfdae._resultfile`).
+
+        Returns
+        -------
+        pathlib.Path
+            The file written. Arrays round-trip bit for bit.
+        """
+        return _resultfile.save(self, path, engine)
 
     @classmethod
-    def load(cls, path) -> "Result":
-        """Read a file written by :meth:`save`."""
-        with np.load(Path(path), allow_pickle=False) as data:
-            meta = json.loads(str(data["metadata"]))
-            if meta.get("format") != "ancfdae.Result/1":
-                raise ValueError(f"{path} is not an ancfdae Result file (format {meta.get('format')!r}).")
-            monitors = {name: dict(vals) for name, vals in meta["monitor_scalars"].items()}
-            for key in data.files:
-                if key.startswith("monitor/"):
-                    _, name, entry = key.split("/", 2)
-                    monitors.setdefault(name, {})[entry] = data[key]
-            return cls(t=data["t"], q=data["q"], v=data["v"], a=data["a"], status=meta["status"],
-                       message=meta["message"], stats=meta["stats"], monitors=monitors,
-                       t_fail=meta["t_fail"], method=meta["method"], options=meta["options"])
+    def load(cls, path: str | os.PathLike) -> "Result":
+        """Read a file written by :meth:`save`.
+
+        Raises
+        ------
+        ResultFileError
+            (a ValueError) naming the file and what is wrong with it: missing,
+            not NetCDF4/HDF5, truncated or damaged, an old ``.npz`` result, or
+            not an ancfdae result.
+        """
+        return _resultfile.load(path)

@@ -3,16 +3,20 @@
 Imitates scipy's ``solve_ivp``: a ``METHODS`` registry, options forwarded to
 the integrator, and a :class:`~ancfdae.result.Result` that reports failure in
 its ``status`` instead of raising. Bad arguments still raise (ValueError /
-TypeError naming the argument).
+TypeError naming the argument). The run itself is the one driver loop of
+:mod:`ancfdae.integrators.driver`; integrators are steppers
+(:mod:`ancfdae.integrators.protocol`), ours and a user's own alike.
 """
 from __future__ import annotations
 
 import inspect
 
-from ancfdae.integrators._base import FixedStepIntegrator
+from ancfdae.integrators.driver import integrate
 from ancfdae.integrators.ida import IDA
 from ancfdae.integrators.lobatto import LobattoIIIA
 from ancfdae.integrators.newmark import GeneralizedAlpha, HHTAlpha, Newmark
+from ancfdae._resultfile import describe_model
+from ancfdae.integrators.protocol import Integrator
 from ancfdae.result import Result
 
 __all__ = ["simulate", "METHODS"]
@@ -21,12 +25,16 @@ __all__ = ["simulate", "METHODS"]
 class Lobatto3(LobattoIIIA):
     """Lobatto IIIA with 3 stages (order 4; the chapter's integrator)."""
 
+    name = "lobatto3"
+
     def __init__(self, model, h, *, newton=None, predictor="constant"):
         super().__init__(model, h, 3, newton=newton, predictor=predictor)
 
 
 class Lobatto2(LobattoIIIA):
     """Lobatto IIIA with 2 stages (trapezoidal rule, order 2)."""
+
+    name = "lobatto2"
 
     def __init__(self, model, h, *, newton=None, predictor="constant"):
         super().__init__(model, h, 2, newton=newton, predictor=predictor)
@@ -43,18 +51,47 @@ METHODS = {
 }
 
 
-def _resolve(method):
+def _label(method):
+    return method if isinstance(method, str) else getattr(method, "name", type(method).__name__)
+
+
+def _build(model, method, h, options):
+    """The stepper for ``method`` (a name, an Integrator subclass or an instance)."""
+    if isinstance(method, Integrator):
+        if options or h is not None:
+            raise ValueError(f"`method` is an integrator instance ({_label(method)!r}): give its step and "
+                             f"options to its constructor, not to simulate (got h={h!r}, options {sorted(options)}).")
+        return method
     if isinstance(method, str):
         if method not in METHODS:
-            raise ValueError(f"`method` must be one of {sorted(METHODS)} or an integrator class, got {method!r}.")
-        return METHODS[method]
-    if inspect.isclass(method) and (issubclass(method, FixedStepIntegrator) or issubclass(method, IDA)):
-        return method
-    raise ValueError(f"`method` must be one of {sorted(METHODS)} or an integrator class, got {method!r}.")
+            raise ValueError(f"`method` must be one of {sorted(METHODS)}, an Integrator subclass or instance, "
+                             f"got {method!r}.")
+        cls = METHODS[method]
+    elif inspect.isclass(method) and issubclass(method, Integrator):
+        cls = method
+    else:
+        raise ValueError(f"`method` must be one of {sorted(METHODS)}, an Integrator subclass or instance, "
+                         f"got {method!r}.")
+    label = _label(method)
+    params = inspect.signature(cls.__init__).parameters
+    allowed = [p for p in params if p not in ("self", "model", "h")]
+    if not any(p.kind is p.VAR_KEYWORD for p in params.values()):
+        unknown = sorted(set(options) - set(allowed))
+        if unknown:
+            raise ValueError(f"unknown option(s) {unknown} for method {label!r}; allowed: {allowed}.")
+    fixed = bool(getattr(cls, "fixed_step", False))
+    if fixed and h is None:
+        raise ValueError(f"`h` (the step size) is required by the fixed-step method {label!r}.")
+    if not fixed and h is not None:
+        raise ValueError(f"`h` is not used by the variable-step method {label!r}; pass `max_step` instead.")
+    try:
+        return cls(model, h, **options) if fixed else cls(model, **options)
+    except (ValueError, TypeError) as exc:
+        raise type(exc)(f"method {label!r}: {exc}") from exc
 
 
 def simulate(model, t_span, method="lobatto3", h=None, t_eval=None, monitors=(), hooks=(), q0=None, v0=None,
-             **options) -> Result:
+             state0=None, max_steps=None, progress=False, **options) -> Result:
     """Integrate ``model`` over ``t_span`` with the named integrator.
 
     Parameters
@@ -62,16 +99,20 @@ def simulate(model, t_span, method="lobatto3", h=None, t_eval=None, monitors=(),
     model : Model
         Anything implementing :class:`ancfdae.problem.Model`.
     t_span : (t0, tf)
-    method : str or class
+    method : str, Integrator subclass or Integrator instance
         A key of :data:`METHODS` -- ``"lobatto3"`` (default, the chapter's
         Lobatto IIIA, order 4), ``"lobatto2"``, ``"newmark"``, ``"hht"``,
-        ``"generalized-alpha"``, ``"ida"`` -- or an integrator class.
+        ``"generalized-alpha"``, ``"ida"`` -- or a class written against
+        :class:`ancfdae.integrators.protocol.Integrator` (built with
+        ``cls(model, h, **options)`` or ``cls(model, **options)``), or a
+        constructed instance (then no ``h`` or options here).
     h : float
         Step size; required by the fixed-step methods, not accepted by IDA
         (use ``max_step``).
     t_eval : array_like, optional
         Output times within ``t_span`` (default: every step). Off-grid times
-        are interpolated (quintic Hermite through ``q, v, a``).
+        are interpolated by the integrator (quintic Hermite through ``q, v, a``
+        for the one-step methods, IDA's own interpolant for IDA).
     monitors : sequence of Monitor
         E.g. ``[EnergyMonitor(), PointSensor(s=1.0)]``; logged at the output
         times into ``Result.monitors``.
@@ -80,31 +121,33 @@ def simulate(model, t_span, method="lobatto3", h=None, t_eval=None, monitors=(),
         the run early (status "success").
     q0, v0 : array_like, optional
         Initial state (default ``model.initial_state()``).
+    state0 : dict, optional
+        The model's event state to start from (models with the
+        ``"step_events"`` capability, e.g. BE3D's ``{"directors": ...}``; a
+        row of a previous ``Result.model_state`` resumes that run).
+    max_steps : int, optional
+        Limit of accepted steps (default 10,000,000). A fixed-step run that
+        needs more is refused before it starts (ValueError); a variable-step
+        run that reaches it ends as failed.
+    progress : bool
+        Show a tqdm progress bar of the simulated time (steps/s, ETA).
     **options
         Passed to the integrator: ``newton=NewtonOptions(...)`` (fixed-step),
         ``beta, gamma`` (newmark), ``alpha`` (hht), ``rho_inf``
         (generalized-alpha), ``predictor`` (lobatto), ``rtol, atol,
-        max_order, ...`` (ida).
+        max_order, linsolver, ...`` (ida).
 
     Returns
     -------
     Result
         ``status`` "success" or "failed" (with ``message`` and ``t_fail``);
-        a failed run keeps every output up to the failure.
+        a failed run -- also one ended by an exception in a user's callback,
+        whose type and text are in ``message`` -- keeps every output up to
+        the failure.
     """
-    cls = _resolve(method)
-    params = inspect.signature(cls.__init__).parameters
-    allowed = [p for p in params if p not in ("self", "model", "h")]
-    unknown = sorted(set(options) - set(allowed))
-    if unknown:
-        raise ValueError(f"unknown option(s) {unknown} for method {getattr(cls, 'name', cls.__name__)!r}; "
-                         f"allowed: {allowed}.")
-    if "h" in params:
-        if h is None:
-            raise ValueError(f"`h` (the step size) is required by the fixed-step method {method!r}.")
-        integrator = cls(model, h, **options)
-    else:
-        if h is not None:
-            raise ValueError(f"`h` is not used by the variable-step method {method!r}; pass `max_step` instead.")
-        integrator = cls(model, **options)
-    return integrator.run(t_span, t_eval=t_eval, monitors=monitors, hooks=hooks, q0=q0, v0=v0)
+    stepper = _build(model, method, h, options)
+    result = integrate(stepper, model, t_span, t_eval=t_eval, monitors=monitors, hooks=hooks, q0=q0, v0=v0,
+                       state0=state0, max_steps=max_steps, progress=bool(progress))
+    if not result.model:   # the model's self-description, for self-describing result files
+        result.model = describe_model(model)
+    return result

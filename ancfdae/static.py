@@ -2,13 +2,16 @@
 from __future__ import annotations
 
 import time as _time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.linalg import LinAlgWarning
 
 from ._validate import positive_int
 from .integrators._newton import NewtonOptions, NewtonSolver, NewtonStats
-from .problem import accept_step
+from ._scale import ROUNDOFF, force_scale
+from .problem import capabilities
 
 __all__ = ["solve_static", "StaticResult"]
 
@@ -32,6 +35,9 @@ class StaticResult:
     stats : NewtonStats
     cpu_time : float
         Process time of the solve in seconds.
+    state : dict
+        The model's event state after the last converged load step (models with the
+        ``"step_events"`` capability, e.g. BE3D's ``{"directors": ...}``); empty otherwise.
     """
 
     q: np.ndarray
@@ -41,14 +47,16 @@ class StaticResult:
     steps: list = field(default_factory=list)
     stats: NewtonStats = field(default_factory=NewtonStats)
     cpu_time: float = 0.0
+    state: dict = field(default_factory=dict)
 
     @property
     def success(self) -> bool:
+        """True when every load step converged."""
         return self.status == "converged"
 
 
 def solve_static(model, load_steps: int = 10, *, t: float = 0.0, q0=None, tol: float = 1e-8,
-                 atol: float = 1e-10, max_iter: int = 25, jacobian: str = "full") -> StaticResult:
+                 atol: float | None = None, max_iter: int = 25, jacobian: str = "full") -> StaticResult:
     """Solve ``r(t, q, 0, 0) = 0`` with the loads applied in uniform steps.
 
     Load step ``i`` solves for the load factor ``lambda_i = i / load_steps``,
@@ -67,7 +75,16 @@ def solve_static(model, load_steps: int = 10, *, t: float = 0.0, q0=None, tol: f
         Time at which the time functions of the loads are evaluated.
     q0 : array_like, optional
         Initial guess; the model's initial state by default.
-    tol, atol, max_iter, jacobian
+    tol : float
+        Relative tolerance: a load step converges when ``max|r| <= tol *
+        max|r_0|``, ``r_0`` the residual at its start (the chapter's test).
+    atol : float, optional
+        Absolute floor in the residual's units. By default it is derived from
+        round-off, ``ROUNDOFF * eps * force_scale(model, t, q0)`` at full load
+        (see :func:`ancfdae._scale.force_scale`), never a fixed number of newtons: a 1e-10 N
+        tip load on a micro-fibre is then solved, not declared converged
+        before the first iteration.
+    max_iter, jacobian
         Newton options, see :class:`ancfdae.integrators._newton.NewtonOptions`
         (``jacobian="full"`` is the chapter's classical Newton).
 
@@ -82,10 +99,15 @@ def solve_static(model, load_steps: int = 10, *, t: float = 0.0, q0=None, tol: f
     if load_steps > 1 and not hasattr(model, "load_factor"):
         raise ValueError("`model` must have a `load_factor` attribute for load stepping; "
                          f"use load_steps=1 with {type(model).__name__}.")
-    solver = NewtonSolver(NewtonOptions(tol=tol, atol=atol, max_iter=max_iter, jacobian=jacobian))
+    caps = capabilities(model)
+    state = model.event_state() if "step_events" in caps else {}
+    m = model.bind(state) if state else model   # the model is never changed; the state is carried here
     q = model.initial_state()[0].copy() if q0 is None else np.array(q0, dtype=float)
     if q.shape != (model.n_dof,):
         raise ValueError(f"`q0` must have shape ({model.n_dof},), got {q.shape}.")
+    if atol is None:
+        atol = ROUNDOFF * np.finfo(float).eps * force_scale(model, t, q)
+    solver = NewtonSolver(NewtonOptions(tol=tol, atol=atol, max_iter=max_iter, jacobian=jacobian))
     z = np.zeros(model.n_dof)
     saved = getattr(model, "load_factor", None)
     steps, status, message = [], "converged", f"converged in {load_steps} load steps"
@@ -94,25 +116,41 @@ def solve_static(model, load_steps: int = 10, *, t: float = 0.0, q0=None, tol: f
         for i in range(1, load_steps + 1):
             lam = i / load_steps
             if saved is not None:
-                model.load_factor = saved * lam
+                m.load_factor = saved * lam
             fused = None
-            if hasattr(model, "residual_jacobian"):
-                def fused(x):
-                    r, J = model.residual_jacobian(t, x, z, z)
+            if "residual_jacobian" in caps:
+                def fused(x, m=m):
+                    r, J = m.residual_jacobian(t, x, z, z)
                     return r, J.K
-            out = solver.solve(lambda x: model.residual(t, x, z, z), lambda x: model.jacobian(t, x, z, z).K, q,
-                               residual_jacobian=fused)
+            # A singular stiffness (no supports: rigid-body motions) makes LAPACK warn and Newton's
+            # correction non-finite; the failed status below says why instead of the warning.
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always", LinAlgWarning)
+                out = solver.solve(lambda x, m=m: m.residual(t, x, z, z), lambda x, m=m: m.jacobian(t, x, z, z).K,
+                                   q, residual_jacobian=fused)
+            singular = [w for w in caught if issubclass(w.category, LinAlgWarning)]
+            for w in caught:
+                if w not in singular or out.converged:
+                    warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
             steps.append({"load_factor": lam, "iterations": out.iterations, "residual": out.residual_norm,
                           "converged": out.converged, "q": out.x if out.converged else q.copy()})
             if not out.converged:
                 status = "failed"
                 message = (f"load step {i} of {load_steps} (load factor {lam:g}) did not converge: "
                            f"{out.message}; max|r| = {out.residual_norm:.3e}")
+                if singular or "singular" in out.message or "factorisation failed" in out.message:
+                    why = f" ({singular[0].message})" if singular else ""
+                    message += (f". The stiffness matrix is singular{why}: a static "
+                                "problem needs supports that remove every rigid-body motion.")
                 break
-            q, _ = accept_step(model, t, out.x, z)
+            q = out.x
+            ev = m.step_event(t, q, z) if state else None
+            if ev is not None:   # BE3D: the directors follow the converged configuration
+                q, _, state = ev
+                m = model.bind(state)
     finally:
         if saved is not None:
             model.load_factor = saved
     return StaticResult(q=q, status=status, message=message,
                         iterations=sum(s["iterations"] for s in steps), steps=steps,
-                        stats=solver.stats, cpu_time=_time.process_time() - start)
+                        stats=solver.stats, cpu_time=_time.process_time() - start, state=state)

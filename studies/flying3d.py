@@ -68,25 +68,33 @@ CLI_OPTIONS = [
 
 
 class UpdateAudit:
-    """A model proxy that measures the energy change made by ``accept_step`` (BE3D's director update).
+    """A model proxy that measures the energy change made by BE3D's director update (a model event).
 
-    Every attribute is the wrapped beam's, except ``accept_step``, which
-    records ``(T + U)(after) - (T + U)(before)`` per call.
+    Every attribute is the wrapped beam's; it declares the beam's capabilities (so the fast paths
+    and the event state are forwarded deliberately) and wraps ``step_event`` to record
+    ``(T + U)(after) - (T + U)(before)`` per update; ``bind`` returns a proxy of the bound beam
+    that records into the same list.
     """
 
-    def __init__(self, beam):
+    def __init__(self, beam, jumps=None):
         self._beam = beam
-        self.jumps = []        # (t, jump)
+        self.jumps = [] if jumps is None else jumps       # (t, jump)
+        self.capabilities = beam.capabilities
 
     def __getattr__(self, name):
         return getattr(self._beam, name)
 
-    def accept_step(self, t, q, v):
-        e0 = self._beam.energy(t, q, v)
-        q2, v2 = self._beam.accept_step(t, q, v)
-        e1 = self._beam.energy(t, q2, v2)
-        self.jumps.append((float(t), (e1.kinetic + e1.strain) - (e0.kinetic + e0.strain)))
-        return q2, v2
+    def bind(self, state):
+        return UpdateAudit(self._beam.bind(state), self.jumps)
+
+    def step_event(self, t, q, v):
+        ev = self._beam.step_event(t, q, v)
+        if ev is not None:
+            q2, v2, state = ev
+            e0 = self._beam.energy(t, q, v)
+            e1 = self._beam.bind(state).energy(t, q2, v2)
+            self.jumps.append((float(t), (e1.kinetic + e1.strain) - (e0.kinetic + e0.strain)))
+        return ev
 
 
 def run_case(case: dict) -> dict:

@@ -1,4 +1,8 @@
 """Shared fixtures and finite-difference helpers for the element tests."""
+from contextlib import contextmanager
+from pathlib import Path
+from unittest import mock
+
 import numpy as np
 import pytest
 
@@ -7,7 +11,7 @@ from ancfdae import Material, RectangularSection
 
 @pytest.fixture
 def steel():
-    """B1 material (benchmarks.md): E = 2.07e11, nu = 0.3, rho = 7800."""
+    """B1 material: E = 2.07e11, nu = 0.3 (chapter Sect. 5.1), rho = 7800 (steel; statics do not use it)."""
     return Material(E=2.07e11, nu=0.3, rho=7800.0)
 
 
@@ -26,3 +30,43 @@ def fd_gradient(fun, x, h=1e-6):
 def rel_err(a, b):
     """max|a - b| / max|b|."""
     return float(np.max(np.abs(np.asarray(a) - np.asarray(b))) / np.max(np.abs(b)))
+
+
+@contextmanager
+def saved_figures():
+    """Record every matplotlib Figure saved inside the block, by file name.
+
+    The studies save and close their figures without returning them; the recorded Figure objects keep
+    their axes and lines, so a test can check what a figure shows (labels, series, data ranges) instead
+    of the size of its PNG file.
+    """
+    from matplotlib.figure import Figure
+    figures = {}
+    original = Figure.savefig
+
+    def record(self, fname, *args, **kwargs):
+        figures[Path(fname).name] = self
+        return original(self, fname, *args, **kwargs)
+
+    with mock.patch.object(Figure, "savefig", record):
+        yield figures
+
+
+def visible_axes(fig):
+    """The figure's visible axes (hidden spare panels of a grid left out)."""
+    return [ax for ax in fig.axes if ax.get_visible()]
+
+
+def series(ax):
+    """``{label: (x, y)}`` of the data lines of an axes (legend-less helper lines keep ``_child`` labels)."""
+    return {ln.get_label(): (np.asarray(ln.get_xdata(), float), np.asarray(ln.get_ydata(), float))
+            for ln in ax.get_lines()}
+
+
+def check_panel(ax, min_lines=1):
+    """A panel shows something: both axis labels, and lines of finite data with at least two points."""
+    assert ax.get_xlabel() and ax.get_ylabel(), "axis labels missing"
+    lines = [(x, y) for x, y in series(ax).values() if x.size >= 2]
+    assert len(lines) >= min_lines, f"{len(lines)} lines with data, expected >= {min_lines}"
+    for x, y in lines:
+        assert np.all(np.isfinite(x)) and np.any(np.isfinite(y))

@@ -9,6 +9,10 @@ from conftest import fd_gradient, rel_err
 REF_BE = np.array([-0.50853730436, 1.20723985455])   # chapter Eq. 113, BE2D/BE3D
 # chapter Table 2, BE2D column: elements -> tip error
 TABLE2_BE2D = {1: 2.585e-1, 2: 3.755e-2, 4: 2.035e-3, 8: 5.060e-5, 16: 1.202e-6, 32: 3.876e-8, 64: 1.820e-9}
+# Agreement with Table 2: its 4 printed digits (5e-3) down to 32 elements. At 64 the error, 1.8e-9 m,
+# nears the precision of the reference itself (Eq. 113 prints 11 decimals: up to 7e-12 m, 0.4 %) and of
+# the chapter's own solution (a relative residual of 1e-8); measured here 1.8454e-9 m, 1.4 % above.
+TABLE2_RTOL = {1: 5e-3, 2: 5e-3, 4: 5e-3, 8: 5e-3, 16: 5e-3, 32: 5e-3, 64: 2e-2}
 
 
 def cantilever(steel, square, n, **kw):
@@ -101,8 +105,8 @@ def test_table2_be2d_errors_and_iterations(steel, square):
         res = solve_static(beam, load_steps=10, tol=1e-8)
         assert res.success, res.message
         errors[n], its[n] = tip_error(beam, res.q), res.iterations
-    for n in (2, 4, 8, 16, 32):
-        assert errors[n] == pytest.approx(TABLE2_BE2D[n], rel=5e-3), n   # 2+ significant digits
+    for n in (2, 4, 8, 16, 32, 64):
+        assert errors[n] == pytest.approx(TABLE2_BE2D[n], rel=TABLE2_RTOL[n]), n
         assert its[n] == 49
     # Convergence order regressed on log-log data. The chapter reports order 4;
     # the measured local slopes fall from 5.4 (8 -> 16) to 4.4 (32 -> 64) as the

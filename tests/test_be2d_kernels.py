@@ -4,7 +4,7 @@ import pytest
 
 from ancfdae import Material, RectangularSection
 from ancfdae.models import BE2D, Beam
-from ancfdae.models import be2d as be2d_module
+from ancfdae.models import _kernel_option
 
 
 def _states(formulation, kernel, n_el=5, seed=0):
@@ -17,7 +17,6 @@ def _states(formulation, kernel, n_el=5, seed=0):
 
 @pytest.mark.parametrize("formulation", ["structural", "continuum"])
 def test_numba_kernel_equals_numpy_kernel(formulation):
-    pytest.importorskip("numba")
     el, beam, states = _states(formulation, "numba")
     assert el.kernel_in_use == "numba"
     scale_f = scale_K = 0.0
@@ -36,12 +35,12 @@ def test_numba_kernel_equals_numpy_kernel(formulation):
 
 
 def test_auto_kernel_follows_numba_availability(monkeypatch):
-    monkeypatch.setattr(be2d_module, "_numba_available", lambda: False)
+    monkeypatch.setattr(_kernel_option, "numba_available", lambda: False)
     el = BE2D(Material(2.1e11, 0.3, 7800.0), RectangularSection(0.1))
     assert el.kernel == "auto" and el.kernel_in_use == "numpy"
     with pytest.raises(ImportError, match="kernel.*numba"):
         BE2D(Material(2.1e11, 0.3, 7800.0), RectangularSection(0.1), kernel="numba")
-    monkeypatch.setattr(be2d_module, "_numba_available", lambda: True)
+    monkeypatch.setattr(_kernel_option, "numba_available", lambda: True)
     assert BE2D(Material(2.1e11, 0.3, 7800.0), RectangularSection(0.1)).kernel_in_use == "numba"
 
 
@@ -52,8 +51,6 @@ def test_unknown_kernel_is_rejected():
 
 @pytest.mark.parametrize("kernel", ["numpy", "numba"])
 def test_residual_stages_equal_per_stage_residuals(kernel):
-    if kernel == "numba":
-        pytest.importorskip("numba")
     from ancfdae import Gravity, PointForce, PointMoment
     beam = Beam(BE2D(Material(2.1e11, 0.3, 7800.0), RectangularSection(0.1), kernel=kernel), 5, 2.0,
                 supports={0: "clamp"}, loads=[PointForce((1e5, 2e5), s=1.3, time=lambda t: 1.0 + t),

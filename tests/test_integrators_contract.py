@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from ancfdae import EnergyMonitor, PointSensor, Probe, simulate
-from ancfdae.integrators._base import hermite5
+from ancfdae.integrators._hermite import hermite5
 from ancfdae.integrators import IDA, GeneralizedAlpha, LobattoIIIA, Newmark, NewtonOptions
 from toy_models import DoublePendulum, SpringChain
 
@@ -57,7 +57,7 @@ def test_contract(method, opts, model_name):
     if model_name == "chain":
         np.testing.assert_allclose(res.monitors["point@3"]["position"], res.q[:, -2:], atol=1e-12)
         np.testing.assert_allclose(res.monitors["point@3"]["velocity"], res.v[:, -2:], atol=1e-12)
-    # the model's accept_step hook ran after every accepted step, in order
+    # the model's step_event ran after every accepted step, in order
     acc = np.array(model.accepted)
     assert acc.size == res.stats["steps"] and np.all(np.diff(acc) > 0) and abs(acc[-1] - 1.0) < 1e-12
     for key in ("steps", "newton_iterations", "residual_evals", "jacobian_evals", "factorizations"):
@@ -146,16 +146,21 @@ def test_unconverged_step_is_never_accepted(cls):
     assert res.status == "failed" and res.t_fail == 0.0 and "failed" in res.message
     assert res.t.size == 1 and model.accepted == []
     assert integ.t == 0.0 and integ.n_steps == 0
-    with pytest.raises(RuntimeError, match="running"):
-        integ.step()
+    out = integ.step()      # the protocol: a failed step reports, the state stays
+    assert not out.ok and "Newton" in out.message and integ.t == 0.0
 
 
 def test_step_by_step_api():
+    """The stepper protocol driven by hand: initialize, step, accept."""
     model = SpringChain(2)
     integ = LobattoIIIA(model, 0.01)
-    assert integ.initialize(0.0)
+    q0, v0 = model.initial_state()
+    integ.initialize(0.0, q0, v0, np.linalg.solve(model.mass(q0).toarray(), -model.residual(0, q0, v0, 0 * q0)),
+                     1.0)
     for _ in range(5):
-        assert integ.step()
+        out = integ.step()
+        assert out.ok and out.t > integ.t
+        integ.accept(out)
     assert abs(integ.t - 0.05) < 1e-15 and integ.stats["steps"] == 5
     res = simulate(SpringChain(2), (0, 0.05), "lobatto3", h=0.01)
     np.testing.assert_allclose(integ.q, res.q[-1], atol=1e-14)
@@ -209,6 +214,6 @@ def test_bad_t_span_and_model():
 
 def test_ida_is_usable_directly():
     res = IDA(DoublePendulum(), rtol=1e-6).run((0, 0.5), t_eval=[0.25, 0.5])
-    assert res.success and res.t.tolist() == [0.25, 0.5] and res.stats["max_order"] == 2
-    res = IDA(SpringChain(2, damping=0.5), rtol=1e-6).run((0, 0.5))
-    assert res.success and res.stats["max_order"] == 5
+    assert res.success and res.t.tolist() == [0.25, 0.5] and res.stats["max_order"] == 5
+    res = IDA(SpringChain(2, damping=0.5), rtol=1e-6, max_order=2).run((0, 0.5))
+    assert res.success and res.stats["max_order"] == 2 and res.options["max_order"] == 2

@@ -1,39 +1,116 @@
-"""Result: time-major arrays, status, save/load round trip (design.md Sect. 6)."""
+"""Result: time-major arrays, status, and the NetCDF4 file round trip."""
+import json
+
 import numpy as np
 import pytest
+import xarray as xr
 
-from ancfdae import EnergyMonitor, PointSensor, Result, simulate
+from ancfdae import EnergyMonitor, Gravity, Material, PointSensor, RectangularSection, Result, ResultFileError, simulate
+from ancfdae.models import BE2D, BE3D, SQ2D, SQ3D, Beam, Cable3D
 from toy_models import SpringChain
 
+SOFT = Material(E=1e6, nu=0.3, rho=1000.0)
+SEC = RectangularSection(0.1)
 
-def test_save_load_round_trip(tmp_path):
-    res = simulate(SpringChain(3, force=(1.0, 0.0), T=0.3), (0, 0.5), "lobatto3", h=0.01,
-                   t_eval=np.linspace(0, 0.5, 6), monitors=[EnergyMonitor(), PointSensor(s=2.5)])
-    path = res.save(tmp_path / "run")
-    assert path.suffix == ".npz" and path.exists()
-    back = Result.load(path)
+
+def _beam(element_cls, **options):
+    el = element_cls(SOFT, SEC, **options)
+    g = [0.0, -9.81] if el.dim == 2 else [0.0, -9.81, 0.0]
+    return Beam(el, 2, 1.0, supports={0: "clamp"}, loads=[Gravity(g)])
+
+
+def _assert_same(back, res):
+    """Every field equal, arrays bit for bit (a float cast or a lossy codec would fail here)."""
     for name in ("t", "q", "v", "a"):
         np.testing.assert_array_equal(getattr(back, name), getattr(res, name))
-    assert (back.status, back.message, back.method, back.t_fail) == (res.status, res.message, res.method, None)
+        assert getattr(back, name).dtype == getattr(res, name).dtype
+    assert (back.status, back.message, back.method, back.t_fail) == (res.status, res.message, res.method, res.t_fail)
     assert back.stats == res.stats and back.options == res.options
+    assert back.model == res.model
+    assert set(back.monitors) == set(res.monitors)
     for name, log in res.monitors.items():
         assert set(back.monitors[name]) == set(log)
         for key, val in log.items():
             if isinstance(val, np.ndarray):
                 np.testing.assert_array_equal(back.monitors[name][key], val)
+            elif isinstance(val, float) and np.isnan(val):
+                assert np.isnan(back.monitors[name][key])
             else:
                 assert back.monitors[name][key] == val
-    assert back.success
+    assert set(back.model_state) == set(res.model_state)
+    for key, val in res.model_state.items():
+        np.testing.assert_array_equal(back.model_state[key], val)
+
+
+def test_save_load_round_trip_toy_model(tmp_path):
+    res = simulate(SpringChain(3, force=(1.0, 0.0), T=0.3), (0, 0.5), "lobatto3", h=0.01,
+                   t_eval=np.linspace(0, 0.5, 6), monitors=[EnergyMonitor(), PointSensor(s=2.5)])
+    path = res.save(tmp_path / "run")
+    assert path.suffix == ".nc" and path.exists()
+    back = Result.load(path)
+    _assert_same(back, res)
+    assert back.success and back.model == {}
+
+
+@pytest.mark.parametrize("method, h", [("lobatto3", 0.01), ("lobatto2", 0.01), ("newmark", 0.01), ("hht", 0.01),
+                                       ("generalized-alpha", 0.01), ("ida", None)])
+def test_round_trip_every_integrator(tmp_path, method, h):
+    res = simulate(_beam(BE2D), (0, 0.03), method, h=h, monitors=[EnergyMonitor(), PointSensor(s=1.0)])
+    assert res.success, res.message
+    _assert_same(Result.load(res.save(tmp_path / f"{method}.nc")), res)
+
+
+@pytest.mark.parametrize("element_cls, options", [(BE2D, {}), (Cable3D, {}), (BE3D, {}), (SQ2D, {}),
+                                                  (SQ3D, {"formulation": "continuum"})])
+def test_round_trip_every_element_with_model_description(tmp_path, element_cls, options):
+    beam = _beam(element_cls, **options)
+    res = simulate(beam, (0, 0.02), "lobatto3", h=0.005, monitors=[EnergyMonitor()])
+    assert res.model["element"]["type"] == element_cls.name
+    if element_cls is BE3D:   # the nodal directors, one row per output, recorded by the driver
+        assert res.model_state["directors"].shape == (res.t.size, beam.n_nodes, 3)
+    back = Result.load(res.save(tmp_path / "r.nc"))
+    _assert_same(back, res)
+    ds = xr.open_dataset(tmp_path / "r.nc")    # plain xarray: labelled variables and the recipe
+    try:
+        node, coord = beam.dof_labels()
+        np.testing.assert_array_equal(ds["node"].values, node)
+        assert list(ds["coordinate"].values) == list(coord)
+        assert ds["q"].dims == ("time", "dof") and ds["monitor.energy.total"].dims == ("time",)
+        assert json.loads(ds.attrs["element"])["type"] == element_cls.name
+        np.testing.assert_array_equal(ds["reference_nodes"].values, beam.points)
+        np.testing.assert_array_equal(ds["element_nodes"].values, beam.element_nodes)
+        assert ds.attrs["formulation"] == options.get("formulation", "structural")
+        if element_cls is BE3D:
+            assert ds["state.directors"].shape == (res.t.size, beam.n_nodes, 3)
+    finally:
+        ds.close()
+
+
+def test_dof_labels_name_node_and_coordinate():
+    beam = _beam(BE3D)   # clamp at node 0 fixes all of node 0 except the axial slope x'
+    node, coord = beam.dof_labels()
+    assert node.size == beam.n_dof
+    full = beam.element.node_coordinates
+    for i, (n, c) in enumerate(zip(node, coord)):   # the label points at the coordinate it names
+        assert beam.free[i] == n * len(full) + full.index(c)
+    assert "theta" in coord and "x'" in coord
 
 
 def test_failed_result_round_trip(tmp_path):
     res = simulate(SpringChain(2), (0, 1), "newmark", h=0.05, monitors=[EnergyMonitor()],
                    newton={"max_iter": 1, "tol": 1e-14, "atol": 0.0, "jacobian": "full"})
     assert not res.success
-    back = Result.load(res.save(tmp_path / "failed.npz"))
+    back = Result.load(res.save(tmp_path / "failed.nc"))
     assert back.status == "failed" and back.t_fail == res.t_fail and back.message == res.message
     assert back.t.size == res.t.size >= 1
     assert "failed" in repr(back)
+
+
+def test_other_engine_reads_and_writes(tmp_path):
+    pytest.importorskip("h5py")
+    res = simulate(SpringChain(2), (0, 0.1), "lobatto3", h=0.01, monitors=[EnergyMonitor()])
+    back = Result.load(res.save(tmp_path / "h5.nc", engine="h5netcdf"))
+    _assert_same(back, res)
 
 
 def test_time_major_shapes_and_validation():
@@ -43,12 +120,66 @@ def test_time_major_shapes_and_validation():
         Result(t=[0.0], q=np.zeros((1, 2)), v=np.zeros((1, 2)), a=np.zeros((1, 2)), status="ok")
     with pytest.raises(ValueError, match="`q` must have shape"):
         Result(t=[0.0, 1.0], q=np.zeros((3, 2)), v=np.zeros((2, 2)), a=np.zeros((2, 2)))
+    with pytest.raises(ValueError, match="model_state"):
+        Result(t=[0.0, 1.0], q=np.zeros((2, 2)), v=np.zeros((2, 2)), a=np.zeros((2, 2)),
+               model_state={"directors": np.zeros((3, 2, 3))})
     empty = Result(t=[], q=np.zeros((0, 4)), v=np.zeros((0, 4)), a=np.zeros((0, 4)), status="failed")
     assert not empty.success and "[]" in repr(empty)
 
 
-def test_load_rejects_foreign_file(tmp_path):
-    p = tmp_path / "x.npz"
-    np.savez(p, metadata=np.array('{"format": "other"}'), t=np.zeros(1))
-    with pytest.raises(ValueError, match="not an ancfdae Result"):
-        Result.load(p)
+def test_save_names_what_is_not_json_able(tmp_path):
+    r = Result(t=[0.0], q=np.zeros((1, 2)), v=np.zeros((1, 2)), a=np.zeros((1, 2)), options={"f": object()})
+    with pytest.raises(ValueError, match="Result.options must be JSON-able"):
+        r.save(tmp_path / "x.nc")
+
+
+def test_empty_failed_result_round_trip(tmp_path):
+    empty = Result(t=[], q=np.zeros((0, 4)), v=np.zeros((0, 4)), a=np.zeros((0, 4)), status="failed",
+                   message="failed at once", t_fail=0.0)
+    back = Result.load(empty.save(tmp_path / "empty.nc"))
+    _assert_same(back, empty)
+
+
+@pytest.fixture
+def saved(tmp_path):
+    res = simulate(SpringChain(2), (0, 0.1), "lobatto3", h=0.01, monitors=[EnergyMonitor()])
+    return res.save(tmp_path / "good.nc")
+
+
+def test_truncated_file_is_a_clear_error(saved, tmp_path):
+    data = saved.read_bytes()
+    bad = tmp_path / "truncated.nc"
+    bad.write_bytes(data[: len(data) // 2])
+    with pytest.raises(ResultFileError, match="truncated.nc.*damaged or truncated"):
+        Result.load(bad)
+
+
+def test_foreign_files_are_clear_errors(tmp_path):
+    text = tmp_path / "notes.txt"
+    text.write_text("hello")
+    with pytest.raises(ResultFileError, match="notes.txt.*not a NetCDF4/HDF5"):
+        Result.load(text)
+    old = tmp_path / "old.npz"
+    np.savez(old, metadata=np.array('{"format": "ancfdae.Result/1"}'), t=np.zeros(1))
+    with pytest.raises(ResultFileError, match="old.npz.*no longer read"):
+        Result.load(old)
+    foreign = tmp_path / "foreign.nc"
+    xr.Dataset({"x": ("i", np.arange(3.0))}, attrs={"title": "other"}).to_netcdf(foreign, engine="netcdf4")
+    with pytest.raises(ResultFileError, match="foreign.nc.*not an ancfdae result"):
+        Result.load(foreign)
+    with pytest.raises(ResultFileError, match="missing.nc.*no such"):
+        Result.load(tmp_path / "missing.nc")
+    assert issubclass(ResultFileError, ValueError)
+
+
+def test_damaged_content_is_a_clear_error(saved, tmp_path):
+    with xr.open_dataset(saved) as ds:
+        ds.load()
+    broken = ds.drop_vars("v")
+    broken.to_netcdf(tmp_path / "novar.nc", engine="netcdf4")
+    with pytest.raises(ResultFileError, match="novar.nc.*variable 'v' is missing"):
+        Result.load(tmp_path / "novar.nc")
+    ds.attrs["stats"] = "{not json"
+    ds.to_netcdf(tmp_path / "badattr.nc", engine="netcdf4")
+    with pytest.raises(ResultFileError, match="badattr.nc.*'stats' is not JSON"):
+        Result.load(tmp_path / "badattr.nc")

@@ -7,7 +7,12 @@ from ancfdae.models import SQ2D, Beam
 
 REF_SQ = np.array([-0.50946471774, 1.20882282955])        # chapter Eq. 113, SQ2D/SQ3D
 # chapter Table 2, SQ2D column: elements -> tip error (m)
-TABLE2_SQ2D = {2: 1.516e-2, 4: 1.327e-3, 8: 9.159e-5, 16: 5.874e-6, 32: 3.695e-7}
+TABLE2_SQ2D = {2: 1.516e-2, 4: 1.327e-3, 8: 9.159e-5, 16: 5.874e-6, 32: 3.695e-7, 64: 2.312e-8}
+# Newton iterations per B1 solve (10 load steps, full Newton from the previous step's solution,
+# max|r| / max|r_0| < 1e-8): a regression value measured with this code, the same for 2-64 elements
+# (per load step 5, 6, 6, 6, 6, 6, 6, 5, 5, 5). Table 2 gives 49 (SQ2D) and 55 (SQ3D); the difference
+# is explained in docs/elements.md (it is the Newton start, not quadrature, clamp or norm).
+B1_ITERATIONS_SQ = 56
 
 
 def cantilever(steel, square, n, **kw):
@@ -30,8 +35,9 @@ def test_b1_reproduces_table2_and_order_4(steel, square):
         assert e == pytest.approx(TABLE2_SQ2D[n], rel=1e-3), n
     order = -np.polyfit(np.log(list(errors)), np.log(list(errors.values())), 1)[0]
     assert 3.7 < order < 4.2
-    # Table 2 reports 49 (SQ2D) and 55 (SQ3D); full Newton here takes 56 for every mesh.
-    assert all(45 <= it <= 60 for it in iterations.values())
+    # Exact: a changed tangent (a wrong term of K slows Newton to linear convergence) or a changed
+    # stopping rule moves it; Table 2's own counts are not reproduced (docs/elements.md).
+    assert iterations == {n: B1_ITERATIONS_SQ for n in TABLE2_SQ2D}
 
 
 def test_b1_full_integration_does_not_reproduce_table2(steel, square):
@@ -50,7 +56,11 @@ def test_linear_element_converges_with_order_2(steel, square):
 
 
 def test_thick_cantilever_reaches_simo_reissner_without_shear_locking(steel):
-    """benchmarks.md B4: h = 0.5 m, b = 0.1 m, tip force 62 500 N."""
+    """Thick cantilever, h = 0.5 m, b = 0.1 m, L = 2 m, tip force 62 500 N.
+
+    Independent reference: the Simo-Reissner (shear-deformable, k_s) rod solution for this load,
+    u_B = (-1.88849e-7, 8.09903254e-4) m.
+    """
     ref = np.array([-1.88849e-7, 8.09903254e-4])
     section = RectangularSection(0.5, 0.1)
     for n, tol in ((2, 1e-7), (8, 1e-9)):

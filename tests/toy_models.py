@@ -44,6 +44,7 @@ class SpringChain:
     """N point masses in the plane; spring i joins mass i-1 (or the hinge at the origin) and mass i."""
 
     mass_is_constant = True
+    capabilities = frozenset({"step_events"})   # records the accepted steps (self.accepted)
 
     def __init__(self, n_masses=3, mass=1.0, k=200.0, l0=1.0, g=9.81, force=(0.0, 0.0), T=1.0,
                  damping=0.0, v0=None, hinge=True):
@@ -142,15 +143,22 @@ class SpringChain:
         th = s - i
         return (1 - th) * P[i] + th * P[i + 1]
 
-    def accept_step(self, t, q, v):
+    def event_state(self):
+        return {}
+
+    def bind(self, state):
+        return self
+
+    def step_event(self, t, q, v):
         self.accepted.append(t)
-        return q, v
+        return None
 
 
 class DoublePendulum:
     """Double pendulum in absolute angles (from the downward vertical); M depends on q."""
 
     mass_is_constant = False
+    capabilities = frozenset({"step_events", "variable_mass"})
     n_dof = 2
 
     def __init__(self, m1=1.0, m2=1.0, l1=1.0, l2=1.0, g=9.81, theta0=(np.pi / 2, np.pi / 2),
@@ -199,6 +207,12 @@ class DoublePendulum:
         return np.array([self.l1 * np.sin(q[0]) + self.l2 * np.sin(q[1]),
                          -self.l1 * np.cos(q[0]) - self.l2 * np.cos(q[1])])
 
-    def accept_step(self, t, q, v):
+    def event_state(self):
+        return {}
+
+    def bind(self, state):
+        return self
+
+    def step_event(self, t, q, v):
         self.accepted.append(t)
-        return q, v
+        return None

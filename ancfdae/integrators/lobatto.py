@@ -21,9 +21,13 @@ the band structure of the model's matrices, has the blocks::
 
     dr_i / dA_k = delta_ik M_i + h a_ik D_i + h^2 (a^2)_ik K_i
 
-with ``K_i, D_i, M_i`` the exact Jacobian blocks at stage ``i``. A model with the optional
-method ``residual_stages(ts, Q, V, A) -> R`` (columns = stages, e.g. :class:`~ancfdae.models.Beam`)
-has all implicit stages' residuals evaluated in one call; otherwise one ``residual`` call per stage.
+with ``K_i, D_i, M_i`` the exact Jacobian blocks at stage ``i`` (full Newton). Modified Newton
+evaluates one set of blocks, at the last stage, and factorises the stage system in the eigenbasis
+of the tableau (:class:`ancfdae.integrators._linsolve.StageMatrix`): for 3 stages one complex n x n
+banded LU instead of a real 2n x 2n one. A model that declares the
+capability ``"residual_stages"`` (:mod:`ancfdae.problem`; ``residual_stages(ts, Q, V, A) -> R``,
+columns = stages, e.g. :class:`~ancfdae.models.Beam`) has all implicit stages' residuals evaluated
+in one call; otherwise one ``residual`` call per stage.
 """
 from __future__ import annotations
 
@@ -34,6 +38,9 @@ import scipy.sparse as sp
 
 from ancfdae import _validate as V
 from ancfdae.integrators._base import FixedStepIntegrator
+from ancfdae.integrators._linsolve import StageMatrix
+from ancfdae.integrators.protocol import Quadrature
+from ancfdae.problem import capabilities
 
 __all__ = ["ButcherTableau", "LOBATTO_IIIA_2", "LOBATTO_IIIA_3", "LobattoIIIA"]
 
@@ -162,6 +169,7 @@ class LobattoIIIA(FixedStepIntegrator):
     def _init_impl(self):
         self._prev = None  # (h, stage accelerations (n, s)) of the last step
         self._w_cache = None
+        self._stages = "residual_stages" in capabilities(self.model)
 
     # -- predictor -------------------------------------------------------------------------
     def _guess(self, h):
@@ -239,7 +247,7 @@ class LobattoIIIA(FixedStepIntegrator):
                 self._set_floor(blk, qs)
                 return self._matrix([blk], h)
         else:
-            stages = getattr(self.model, "residual_stages", None)
+            stages = self.model.residual_stages if self._stages else None
 
             def residual(x):
                 X = x.reshape(n, m)
@@ -255,6 +263,16 @@ class LobattoIIIA(FixedStepIntegrator):
             def jacobian(x):
                 X = x.reshape(n, m)
                 Q, V_ = Q0 + X @ CQ, V0 + X @ CV
+                if self.newton.options.jacobian == "modified":
+                    # Modified Newton reuses the matrix across steps anyway: one set of blocks (at
+                    # the last stage) lets the stage system split in the tableau's eigenbasis.
+                    blk = self._jacobian(ts[-1], Q[:, -1], V_[:, -1], X[:, -1])
+                    self._set_floor(blk, Q[:, -1])
+                    if blk.same_pattern:
+                        return StageMatrix(blk, h, self._a_rest)
+                    blocks = [blk if i == m - 1 else self._jacobian(ts[i], Q[:, i], V_[:, i], X[:, i])
+                              for i in range(m)]
+                    return self._matrix(blocks, h)
                 blocks = [self._jacobian(ts[i], Q[:, i], V_[:, i], X[:, i]) for i in range(m)]
                 for i, blk in enumerate(blocks):
                     self._set_floor(blk, Q[:, i])
@@ -267,8 +285,8 @@ class LobattoIIIA(FixedStepIntegrator):
         Q, V_ = Q0 + X @ CQ, V0 + X @ CV
         if self.predictor == "extrapolate":
             self._prev = (h, np.column_stack([self.a, X]))
-        nodes = None
-        if self.want_nodes:  # the step's Lobatto quadrature, for monitors that integrate over it
-            nodes = (np.r_[t, ts], np.column_stack([self.q, Q]).T, np.column_stack([self.v, V_]).T,
-                     h * self.tableau.b)
-        return True, (Q[:, -1].copy(), V_[:, -1].copy(), X[:, -1].copy(), nodes)
+        quad = None
+        if self.want_quadrature:  # the step's Lobatto quadrature, for monitors that integrate over it
+            quad = Quadrature(np.r_[t, ts], np.column_stack([self.q, Q]).T, np.column_stack([self.v, V_]).T,
+                              h * self.tableau.b)
+        return True, (Q[:, -1].copy(), V_[:, -1].copy(), X[:, -1].copy(), quad)

@@ -18,15 +18,27 @@ A stepper implements
 ``interpolate(t) -> (q, v, a)``
     the state at a time inside the last step (default: quintic Hermite through ``(q, v, a)`` at
     the step's ends; a stepper with its own dense output overrides it);
+``accept(outcome)``
+    make a successful step's state the current one (the driver calls it; the base class keeps
+    the previous state for :meth:`interpolate`);
 ``restart(t, q, v, a, model)``
     continue from a state that a model event changed (the driver passes the model bound to the
-    event's new state and a consistent acceleration); multistep methods drop their history;
+    event's new state); multistep methods drop their history. ``a`` is an acceleration
+    recomputed consistently with the new state when the class sets ``consistent_restart = True``
+    (IDA), else the step's own (one-step methods carry on);
 ``stats`` and ``options()``
     counters since ``initialize`` and the options as a JSON-able dict (both stored in the Result).
 
 Class attributes: ``name`` (the key of :data:`ancfdae.METHODS` or a user's label), ``order``
-(the classical order, or None), and ``fixed_step`` (True when the constructor takes the step
-size ``h``).
+(the classical order, or None), ``fixed_step`` (True when the constructor takes the step
+size ``h``) and ``consistent_restart``.
+
+Before ``initialize`` the driver sets two attributes: ``model`` (the model bound to the run's
+initial event state; a stepper must evaluate ``self.model``, never a model it kept elsewhere) and
+``want_quadrature`` (True when monitors will use the step's quadrature; a stepper may skip
+building it otherwise). The driver also checks the model's declared capabilities
+(:func:`ancfdae.problem.capabilities`); a stepper uses a fast path only when it is declared.
+:meth:`Integrator.run` runs a constructed stepper through the same driver.
 """
 from __future__ import annotations
 
@@ -102,6 +114,8 @@ class Integrator(ABC):
     name: str = "integrator"
     order: int | None = None
     fixed_step: bool = True
+    consistent_restart: bool = False
+    want_quadrature: bool = False
 
     def __init__(self, model, h: float | None = None):
         self.model = model
@@ -146,3 +160,12 @@ class Integrator(ABC):
     def options(self) -> dict:
         """The integrator's options as a JSON-able dict."""
         return {"h": self.h} if self.fixed_step else {}
+
+    def run(self, t_span, **kwargs):
+        """Integrate ``self.model`` over ``t_span`` through the driver.
+
+        Keyword arguments are those of :func:`ancfdae.simulate` without ``method``, ``h`` and the
+        integrator's options (``t_eval, monitors, hooks, q0, v0, state0, max_steps, progress``).
+        """
+        from ancfdae.integrators.driver import integrate  # noqa: PLC0415 - the driver imports this module
+        return integrate(self, self.model, t_span, **kwargs)

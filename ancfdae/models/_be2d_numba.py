@@ -1,4 +1,4 @@
-"""Compiled BE2D kernel (optional, needs numba: ``pip install "ancfdae[fast]"``).
+"""Compiled BE2D kernel (the default of :class:`ancfdae.models.BE2D`, ``kernel="auto"``).
 
 The same force and exact tangent as the NumPy kernel of :class:`ancfdae.models.BE2D`
 (chapter Eqs. 70, 78, 82-88, written in the invariants ``g = r'.r'`` and
@@ -16,7 +16,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["be2d_forces", "STRUCTURAL", "CONTINUUM"]
+from ._assembly_numba import gather_elements, scatter
+
+__all__ = ["be2d_forces", "be2d_fused", "STRUCTURAL", "CONTINUUM"]
 
 STRUCTURAL, CONTINUUM = 0, 1
 
@@ -62,14 +64,18 @@ def be2d_forces(q, dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4, tangent)
     the axial points (the first ``n_a``) then the bending points; ``w``
     (n_el, n_pts) weights times the Jacobian ``L/2``. The tangent is
     ``W_gg dg dg^T + W_gc (dg dc^T + dc dg^T) + W_cc dc dc^T + W_g d2g + W_c d2c``
-    with the constant Hessians d2g, d2c formed on the fly.
+    with the constant Hessians d2g, d2c formed on the fly; it is symmetric, so
+    its upper triangle is accumulated and mirrored.
     """
     n_el, n_pts = w.shape
     f = np.zeros((n_el, 8))
-    K = np.zeros((n_el, 8, 8) if tangent else (0, 8, 8))
+    K = np.empty((n_el, 8, 8) if tangent else (0, 8, 8))
+    Ku = np.empty((8, 8))   # upper triangle of one element's tangent (it is symmetric)
     dg = np.empty(8)
     dc = np.empty(8)
     for e in range(n_el):
+        if tangent:
+            Ku[:] = 0.0
         for p in range(n_pts):
             # r' and r'' at the point
             r1x = r1y = r2x = r2y = 0.0
@@ -80,7 +86,8 @@ def be2d_forces(q, dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4, tangent)
                 r2y += ddN[e, p, k] * q[e, 2 * k + 1]
             g = r1x * r1x + r1y * r1y
             wp = w[e, p]
-            if p < n_a:
+            axial = p < n_a
+            if axial:
                 Wg, Wgg = _densities_axial(form, g, eps_ref[e, p], EA)
                 Wc = Wgc = Wcc = 0.0
             else:
@@ -94,26 +101,59 @@ def be2d_forces(q, dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4, tangent)
                 dc[2 * k] = a * r2y - b * r1y
                 dc[2 * k + 1] = -a * r2x + b * r1x
             wg, wc = wp * Wg, wp * Wc
-            for i in range(8):
-                f[e, i] += dg[i] * wg + dc[i] * wc
+            if axial:   # W depends on g alone here: dc terms vanish
+                for i in range(8):
+                    f[e, i] += dg[i] * wg
+            else:
+                for i in range(8):
+                    f[e, i] += dg[i] * wg + dc[i] * wc
             if not tangent:
                 continue
             wgg, wgc, wcc = wp * Wgg, wp * Wgc, wp * Wcc
-            for i in range(8):
-                bg = dg[i] * wgg + dc[i] * wgc
-                bc = dg[i] * wgc + dc[i] * wcc
-                for j in range(8):
-                    K[e, i, j] += bg * dg[j] + bc * dc[j]
+            if axial:
+                for i in range(8):
+                    bg = dg[i] * wgg
+                    for j in range(i, 8):
+                        Ku[i, j] += bg * dg[j]
+            else:
+                for i in range(8):
+                    bg = dg[i] * wgg + dc[i] * wgc
+                    bc = dg[i] * wgc + dc[i] * wcc
+                    for j in range(i, 8):
+                        Ku[i, j] += bg * dg[j] + bc * dc[j]
             # Constant Hessians: d2g = 2 dN_k dN_l delta_ab, d2c = dN_k ddN_l P_ab + ddN_k dN_l P_ba,
-            # P = [[0, 1], [-1, 0]].
+            # P = [[0, 1], [-1, 0]]; upper triangle only (rows 2k, 2k+1 <= columns 2m, 2m+1).
             for k in range(4):
                 ak, bk = dN[e, p, k], ddN[e, p, k]
-                for m in range(4):
+                for m in range(k, 4):
                     am, bm = dN[e, p, m], ddN[e, p, m]
                     hg = 2.0 * wg * ak * am
-                    hc = wc * (ak * bm - bk * am)
-                    K[e, 2 * k, 2 * m] += hg
-                    K[e, 2 * k + 1, 2 * m + 1] += hg
-                    K[e, 2 * k, 2 * m + 1] += hc
-                    K[e, 2 * k + 1, 2 * m] -= hc
+                    Ku[2 * k, 2 * m] += hg
+                    Ku[2 * k + 1, 2 * m + 1] += hg
+                    if not axial:
+                        hc = wc * (ak * bm - bk * am)
+                        Ku[2 * k, 2 * m + 1] += hc
+                        if m > k:
+                            Ku[2 * k + 1, 2 * m] -= hc
+        if tangent:
+            for i in range(8):
+                for j in range(i, 8):
+                    K[e, i, j] = Ku[i, j]
+                    K[e, j, i] = Ku[i, j]
     return f, K
+
+
+@njit(cache=True)
+def be2d_fused(q, q_fixed, gather, vec_slot, mat_slot, tangent, r, kdata,
+               dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4):
+    """Gather, kernel and scatter in one call (the fused assembly of ``_assembly_numba``).
+
+    ``r`` (length ``n_dof + 1``) receives the assembled ``dU/dq`` and, if
+    ``tangent``, ``kdata`` (length ``nnz + 1``) the CSR data of its tangent;
+    the last entry of each collects the fixed coordinates' share.
+    """
+    qe = gather_elements(q, q_fixed, gather)
+    f, K = be2d_forces(qe, dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4, tangent)
+    scatter(f, vec_slot, r)
+    if tangent:
+        scatter(K, mat_slot, kdata)

@@ -65,7 +65,7 @@ import numpy as np
 
 from ._be3d_kinematics import director_field, frames, spin_coefficients, spin_gradient
 
-__all__ = ["rotary_inertia", "rotary_kinetic_energy", "update_directors", "UPDATES"]
+__all__ = ["rotary_inertia", "rotary_kinetic_energy", "update_directors", "director_sines", "UPDATES"]
 
 UPDATES = ("projected", "post-rotated", "none")
 
@@ -126,15 +126,20 @@ def rotary_inertia(rule, geom, q, v, acc, rhoJ, jacobian=True):
     return f, dfdq, dfdv, dfda
 
 
-def update_directors(geom, Q, V, variant):
-    """Apply the director update in place on ``geom["directors"]``; return the new ``(Q, V)``.
+def director_sines(D, Q):
+    """Sine of the angle between each nodal director and the axis ``r'`` (1 = normal, 0 = parallel)."""
+    a = Q[:, 3:6]
+    return np.linalg.norm(np.cross(D, a), axis=-1) / (np.linalg.norm(D, axis=-1) * np.linalg.norm(a, axis=-1))
 
-    ``Q``, ``V``: nodal coordinates and velocities, shape (n_nodes, 7),
-    per node ``(x, y, z, x', y', z', theta)``.
+
+def update_directors(D, Q, V, variant):
+    """The director update; return the new ``(Q, V, D)`` (the arguments are not changed).
+
+    ``D``: nodal directors, shape (n_nodes, 3); ``Q``, ``V``: nodal coordinates and velocities,
+    shape (n_nodes, 7), per node ``(x, y, z, x', y', z', theta)``.
     """
     if variant == "none":
-        return Q, V
-    D = geom["directors"]
+        return Q, V, D
     a = Q[:, 3:6]
     with np.errstate(invalid="ignore", divide="ignore"):   # a singular node is reported below
         F, n = frames(a, Q[:, 6], D)
@@ -149,9 +154,10 @@ def update_directors(geom, Q, V, variant):
     if variant == "projected":
         # e30 (Eq. 99): turn e3 back by theta, since e3 = c e30 - s e20 and e2 = c e20 + s e30.
         c, s = np.cos(Q[:, 6])[:, None], np.sin(Q[:, 6])[:, None]
-        D[:] = c * F[:, :, 2] + s * F[:, :, 1]
+        D = c * F[:, :, 2] + s * F[:, :, 1]
     else:
-        D[:] = F[:, :, 2]
+        D = F[:, :, 2].copy()
         Q[:, 6] = 0.0
     V[:, 6] = omega1
-    return Q, V
+    D.setflags(write=False)
+    return Q, V, D

@@ -4,7 +4,7 @@ An element type is a class with a few class attributes describing its node
 layout and methods that work on *all elements at once*: element coordinate
 arrays have shape ``(n_el, n_edof)`` and element matrices
 ``(n_el, n_edof, n_edof)``; kernels loop over neither elements nor quadrature
-points in Python (design.md Sect. 4).
+points in Python.
 
 Conventions
 -----------
@@ -35,8 +35,8 @@ __all__ = ["Element"]
 class Element(ABC):
     """Base class of the ANCF element types.
 
-    Class attributes
-    ----------------
+    Attributes
+    ----------
     name : str
         Short name used in tables ("BE2D", "SQ3D", ...).
     dim : int
@@ -50,10 +50,16 @@ class Element(ABC):
         False only for elements whose mass matrix depends on q (BE3D).
     formulations : tuple of str
         The formulation variants the element offers.
+    material : Material
+        Instance attribute, required: the beam reads ``rho`` from it.
+    section : RectangularSection or CircularSection
+        Instance attribute, required: the beam reads ``A`` from it.
 
-    Instance attributes ``material`` (:class:`ancfdae.materials.Material`)
-    and ``section`` (a section of :mod:`ancfdae.materials`) are required: the
-    beam reads ``rho * A`` from them for gravity.
+    Notes
+    -----
+    The attributes up to ``formulations`` are class attributes. Subclasses
+    keep every constructor option under its argument name, so that
+    :meth:`Beam.describe` records it and a result file can rebuild the element.
     """
 
     name: ClassVar[str]
@@ -103,7 +109,7 @@ class Element(ABC):
         ``kind`` is ``"clamp"`` (position and orientation) or ``"pin"``
         (position only). ``frame`` is the node's reference frame; elements
         use it to leave the axial stretch free at a clamp where that can be
-        done by fixing coordinates (benchmarks.md B1).
+        done by fixing coordinates (the cantilever of chapter Sect. 5.1).
         """
 
     @abstractmethod
@@ -120,7 +126,7 @@ class Element(ABC):
 
     # -- kernels ------------------------------------------------------------
     @abstractmethod
-    def mass_matrix(self, geom) -> np.ndarray:
+    def mass_matrix(self, geom: Any) -> np.ndarray:
         """Constant element mass matrices, shape (n_el, n_edof, n_edof).
 
         For an element with ``mass_is_constant = False`` this is the constant
@@ -128,11 +134,11 @@ class Element(ABC):
         """
 
     @abstractmethod
-    def strain_energy(self, geom, q: np.ndarray) -> np.ndarray:
+    def strain_energy(self, geom: Any, q: np.ndarray) -> np.ndarray:
         """Strain energy of each element, shape (n_el,)."""
 
     @abstractmethod
-    def internal_forces(self, geom, q: np.ndarray, tangent: bool = True):
+    def internal_forces(self, geom: Any, q: np.ndarray, tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """``f = dU/dq_e`` and, if ``tangent``, ``K = d f / d q_e``.
 
         Returns
@@ -151,8 +157,8 @@ class Element(ABC):
         """
 
     @abstractmethod
-    def moment_load(self, geom, q: np.ndarray, s: float, moment: np.ndarray, element: int,
-                    tangent: bool = True):
+    def moment_load(self, geom: Any, q: np.ndarray, s: float, moment: np.ndarray, element: int,
+                    tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """Generalised force of a dead moment acting at axis point ``s`` of one element.
 
         The virtual work of a moment is ``M . delta phi`` with the virtual
@@ -173,8 +179,21 @@ class Element(ABC):
         dfdq : ndarray, shape (n_edof, n_edof), or None
         """
 
+    # -- optional: fused compiled assembly ----------------------------------
+    def fused_kernel(self, geom):
+        """The element's fused gather-kernel-scatter entry point, or None (the default).
+
+        An element with a compiled kernel returns ``(fn, args)``; the beam then
+        assembles the internal forces and tangent by the single call
+        ``fn(q, q_fixed, gather, vec_slot, mat_slot, tangent, r, kdata, *args)``
+        (the contract is in :mod:`ancfdae.models._assembly_numba`), which must
+        give the same arrays as :meth:`internal_forces` followed by the beam's
+        scatter. ``geom`` may be the geometry of stacked copies of the mesh.
+        """
+        return None
+
     # -- optional: configuration-dependent inertia (BE3D) ------------------
-    def inertia(self, geom, q, v, a, jacobian: bool = True):
+    def inertia(self, geom: Any, q: np.ndarray, v: np.ndarray, a: np.ndarray, jacobian: bool = True) -> tuple:
         """Inertia forces beyond the constant mass matrix.
 
         Only for ``mass_is_constant = False``: returns ``f`` of shape
@@ -184,15 +203,23 @@ class Element(ABC):
         """
         raise NotImplementedError
 
-    def kinetic_energy_extra(self, geom, q, v) -> np.ndarray:
+    def kinetic_energy_extra(self, geom: Any, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Kinetic energy beyond ``1/2 v^T M_const v``, shape (n_el,)."""
         return np.zeros(len(q))
 
-    def accept_step(self, geom, Q: np.ndarray, V: np.ndarray):
-        """Hook after an accepted time or load step (BE3D director update).
+    def event_state(self, geom: Any) -> dict:
+        """The element's event state in ``geom`` (arrays that may change between steps); none by default."""
+        return {}
+
+    def bind(self, geom: Any, state: dict) -> Any:
+        """A geometry equal to ``geom`` but with the event ``state`` (``geom`` is not changed)."""
+        return geom
+
+    def step_event(self, geom: Any, Q: np.ndarray, V: np.ndarray) -> tuple | None:
+        """Event after an accepted time or load step (BE3D's director update); None = nothing changed.
 
         ``Q``, ``V``: full nodal coordinate and velocity arrays, shape
-        (n_nodes_global, n_node_dof). Returns the (possibly re-parametrised)
-        ``(Q, V)``; the physical configuration must not change.
+        (n_nodes_global, n_node_dof). Returns None or the (re-parametrised) ``(Q, V, state)``
+        with the new event state; the physical configuration must not change.
         """
-        return Q, V
+        return None

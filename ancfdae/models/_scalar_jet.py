@@ -10,7 +10,7 @@ The BE3D element writes its curvature, twist and cross-section angular
 velocity as short expressions in a few polynomial invariants of the slope
 ``r'`` and its derivative ``r''``; propagating jets through those expressions
 gives the exact first and second derivatives without hand-expanded formulae
-(design.md Sect. 3: exact Jacobians, analytic or automatic differentiation).
+(the model contract asks for exact Jacobians, never finite differences).
 :mod:`._jet` holds the vector-valued, function-style jets of the SQ elements;
 this module overloads the arithmetic operators of scalar jets instead, which
 keeps the BE3D expressions readable as written in the chapter.

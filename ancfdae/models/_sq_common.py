@@ -14,12 +14,21 @@ from .._validate import choice
 from ..materials import CircularSection, Material, RectangularSection
 from ._element import Element
 from ._quadrature import gauss
+from ._kernel_option import resolve_kernel
 from ._sq_kernels import assemble, continuum_kernel, local_map, rule, shapes, structural_kernel, voigt
 
-__all__ = ["SQElement"]
+__all__ = ["SQElement", "shear_factors"]
 
 _STRUCTURAL_TERMS = ("axial", "shear", "bending", "cross_section")
 _CONTINUUM_TERMS = ("axial", "section")
+
+
+def shear_factors(section, material) -> tuple[float, float]:
+    """``(k2, k3)`` of a section: ``shear_factors_of`` where the section has it, else ``k_s`` twice."""
+    if hasattr(section, "shear_factors_of"):
+        return section.shear_factors_of(material)
+    k = section.k_s(material)
+    return k, k
 
 
 class SQElement(Element):
@@ -31,7 +40,7 @@ class SQElement(Element):
     _terms: tuple[str, ...] = ()
 
     def __init__(self, material: Material, section, formulation: str = "structural", nodes: int = 3,
-                 quadrature: dict | None = None):
+                 quadrature: dict | None = None, kernel: str = "auto"):
         if not isinstance(material, Material):
             raise TypeError(f"`material` must be an ancfdae Material, got {material!r}.")
         self.formulation = choice("formulation", formulation, self.formulations)
@@ -50,10 +59,26 @@ class SQElement(Element):
         # Per instance: the node layout depends on `nodes` (the class default is the quadratic element).
         self.node_params = (-1.0, 1.0, 0.0) if nodes == 3 else (-1.0, 1.0)
         self.quadrature = self._parse_quadrature(quadrature)
+        self.kernel = kernel
+
+    @property
+    def kernel(self) -> str:
+        """The ``kernel`` option as given ("auto", "numpy" or "numba")."""
+        return self._kernel
+
+    @kernel.setter
+    def kernel(self, value):
+        self._impl = resolve_kernel(value)
+        self._kernel = value
+
+    @property
+    def kernel_in_use(self) -> str:
+        """The implementation that runs: "numpy" or "numba"."""
+        return self._impl
 
     def __repr__(self):
         return (f"{self.name}(formulation={self.formulation!r}, nodes={self.nodes}, "
-                f"quadrature={self.quadrature!r})")
+                f"quadrature={self.quadrature!r}, kernel={self._kernel!r})")
 
     # -- options ----------------------------------------------------------------------------
     def default_quadrature(self) -> dict:
@@ -70,7 +95,7 @@ class SQElement(Element):
         integration locks in shear here too: 3 points make one quadratic
         element 5 % too stiff in bending), 3 x 3 Gauss points over a
         rectangular section (exact for the quartic St. Venant-Kirchhoff
-        energy); ``{"axial": 3}`` is Chrono's full integration (benchmarks.md B4).
+        energy); ``{"axial": 3}`` is Project Chrono's full integration.
         """
         n = self.nodes
         if self.formulation == "structural":
@@ -149,7 +174,7 @@ class SQElement(Element):
             scale = np.where(cs[None, :], jac[:, None], 1.0 / jac[:, None])
             wq = (w[None, :] * lengths[:, None] / 2).reshape(-1)
             Dw = self._stiffness()[which][None, :] * wq[:, None] * scale
-            groups.append({"which": which, "B": B, "ref": raw, "Dw": Dw})
+            groups.append({"which": which, "B": B, "ref": raw, "Dw": Dw, "N": N, "dN": dN})
         geom["groups"] = groups
 
     def _section_points(self):
@@ -175,16 +200,18 @@ class SQElement(Element):
 
     def _elasticity(self):
         """Full elasticity matrix and its split D0 + Dnu (Eqs. 34, 108); 2D: plane stress."""
-        mat, k = self.material, self.section.k_s(self.material)
+        mat = self.material
+        k2, k3 = shear_factors(self.section, mat)
         E, nu, G = mat.E, mat.nu, mat.G
         if self.dim == 3:
             lam = E * nu / ((1 + nu) * (1 - 2 * nu))
-            normal = lam * np.ones((3, 3)) + 2 * G * np.eye(3)          # Eq. 34, corrected (benchmarks.md)
-            shear = np.diag([G, k * G, k * G])                          # gamma_23, gamma_13, gamma_12
+            normal = lam * np.ones((3, 3)) + 2 * G * np.eye(3)          # Eq. 34 as the standard isotropic law (the chapter's text lost its factors)
+            # gamma_23 (in the section, no correction), gamma_13 (along zeta: k3), gamma_12 (along eta: k2)
+            shear = np.diag([G, k3 * G, k2 * G])
         else:
             Ep = E / (1 - nu**2)
             normal = Ep * np.array([[1.0, nu], [nu, 1.0]])
-            shear = np.array([[k * G]])
+            shear = np.array([[k2 * G]])
         n = normal.shape[0]
         D = np.zeros((n + shear.shape[0],) * 2)
         D[:n, :n], D[n:, n:] = normal, shear
@@ -221,7 +248,7 @@ class SQElement(Element):
         _, T = voigt(self.dim)
         ref = 0.5 * np.einsum("acd,pscd->psa", T, C)
         wax = (w[None, :] * lengths[:, None] / 2).reshape(-1)
-        geom["groups"] = [{"B": B, "Pc": Pc, "ws": ws, "Ds": Ds, "ref": ref, "wax": wax}]
+        geom["groups"] = [{"B": B, "Pc": Pc, "ws": ws, "Ds": Ds, "ref": ref, "wax": wax, "N": N, "dN": dN}]
 
     def _mass(self, lengths, q_ref):
         """``rho int S^T S dV`` (Eq. 27): ``rho int N_i N_j dS`` times diag(A, I3, I2) per node vector."""
@@ -259,13 +286,46 @@ class SQElement(Element):
                 K = Kg if K is None else K + Kg
         return W, f, K
 
+    def _evaluate_numba(self, geom, q, order):
+        """The compiled kernel (:mod:`ancfdae.models._sq_numba`); its arrays are built once per geometry."""
+        from . import _sq_numba
+        nbg = geom.get("_numba")
+        if nbg is None:
+            nbg = geom["_numba"] = _numba_geometry(self.formulation, self.dim, self._stiffness_count(), geom)
+        q = np.ascontiguousarray(q, dtype=float)
+        if self.formulation == "structural":
+            return _sq_numba.sq_structural(q, *nbg, self.dim, order)
+        return _sq_numba.sq_continuum(q, *nbg, self.dim, order)
+
+    def fused_kernel(self, geom):
+        """The fused compiled entry point ``(fn, args)`` with the compiled kernel selected, else None."""
+        if self._impl != "numba":
+            return None
+        hit = geom.get("_numba_fused")
+        if hit is None:
+            from . import _sq_fused_numba as fz
+            nbg = geom.get("_numba")
+            if nbg is None:
+                nbg = geom["_numba"] = _numba_geometry(self.formulation, self.dim, self._stiffness_count(), geom)
+            fn = fz.sq_structural_fused if self.formulation == "structural" else fz.sq_continuum_fused
+            hit = geom["_numba_fused"] = (fn, tuple(nbg) + (self.dim,))
+        return hit
+
+    def _stiffness_count(self) -> int:
+        return len(self._terms)
+
     def mass_matrix(self, geom):
         return geom["M"]
 
     def strain_energy(self, geom, q):
+        if self._impl == "numba":
+            return self._evaluate_numba(geom, q, 0)[0]
         return self._evaluate(geom, q, 0)[0]
 
     def internal_forces(self, geom, q, tangent=True):
+        if self._impl == "numba":
+            _, f, K = self._evaluate_numba(geom, q, 2 if tangent else 1)
+            return f, (K if tangent else None)
         _, f, K = self._evaluate(geom, q, 2 if tangent else 1)
         return f, K
 
@@ -283,6 +343,53 @@ class SQElement(Element):
         return local_map(N, dN, self.dim)[0, 0, :self.dim * (self.dim - 1)]
 
     def moment_load(self, geom, q, s, moment, element, tangent=True):
+        if self._impl == "numba":
+            from ._sq_numba_moment import sq_moment_load
+            f, K = sq_moment_load(np.ascontiguousarray(q, dtype=float), float(s), self.nodes, self.dim,
+                                  np.ascontiguousarray(moment, dtype=float), bool(tangent))
+            return f, (K if tangent else None)
         Bp = self._slope_map(geom, s, element)
         fp, dfp = self._rotation_force(Bp @ np.asarray(q, dtype=float), np.asarray(moment, dtype=float))
         return Bp.T @ fp, (Bp.T @ dfp @ Bp if tangent else None)
+
+
+def _numba_geometry(formulation, dim, n_strain, geom):
+    """Contiguous arrays for the compiled kernels, from the NumPy kernel's point groups.
+
+    Structural: every group's points concatenated per element, with the stiffness and the
+    reference strains widened to all strain components (zero where a group's terms do not act).
+    Continuum: the section map ``Pc`` as the sparse table the compiled kernel walks.
+    """
+    groups = geom["groups"]
+    n_el = groups[0]["N"].shape[0]
+    N = np.ascontiguousarray(np.concatenate([g["N"] for g in groups], axis=1))
+    dN = np.ascontiguousarray(np.concatenate([g["dN"] for g in groups], axis=1))
+    if formulation == "structural":
+        Dw, ref = [], []
+        for g in groups:
+            P = g["N"].shape[1]
+            full_D, full_r = np.zeros((n_el, P, n_strain)), np.zeros((n_el, P, n_strain))
+            full_D[:, :, g["which"]] = g["Dw"].reshape(n_el, P, -1)
+            full_r[:, :, g["which"]] = g["ref"].reshape(n_el, P, -1)
+            Dw.append(full_D)
+            ref.append(full_r)
+        return N, dN, np.ascontiguousarray(np.concatenate(Dw, axis=1)), np.ascontiguousarray(np.concatenate(ref, axis=1))
+    (g,) = groups
+    Pc = g["Pc"]
+    S, _, nb = Pc.shape
+    used = [[b for b in range(nb) if np.any(Pc[:, c, b] != 0.0)] for c in range(dim)]
+    width = max(len(u) for u in used)
+    blk = np.zeros((S, dim, width), dtype=np.int64)
+    coef = np.zeros((S, dim, width))
+    cnt = np.zeros((S, dim), dtype=np.int64)
+    for c, u in enumerate(used):
+        blk[:, c, :len(u)] = u
+        coef[:, c, :len(u)] = Pc[:, c, u]
+        cnt[:, c] = len(u)
+    pairs, _ = voigt(dim)
+    vi = np.array([p[0] for p in pairs], dtype=np.int64)
+    vj = np.array([p[1] for p in pairs], dtype=np.int64)
+    P = g["N"].shape[1]
+    return (N, dN, np.ascontiguousarray(g["wax"].reshape(n_el, P)), blk, coef, cnt,
+            np.ascontiguousarray(g["ws"], dtype=float), np.ascontiguousarray(g["Ds"], dtype=float),
+            np.ascontiguousarray(g["ref"].reshape(n_el, P, S, -1)), vi, vj)

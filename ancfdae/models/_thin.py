@@ -44,7 +44,9 @@ class PointRule:
     Attributes
     ----------
     s : (n_pts,) normalised coordinates; ``wdx`` : (n_el, n_pts) weights of ``dxi``;
-    S, Ba, Bb : (n_el, n_pts, 3, n_edof) operators giving ``r``, ``r'`` and ``r''``.
+    S, Ba, Bb : (n_el, n_pts, 3, n_edof) operators giving ``r``, ``r'`` and ``r''``;
+    dN, ddN : (n_el, n_pts, 4) the Hermite functions' derivatives themselves (C-contiguous,
+    the compiled kernels' input).
     """
 
     def __init__(self, n_points, lengths: np.ndarray, dof_map: np.ndarray, n_edof: int):
@@ -55,6 +57,7 @@ class PointRule:
             w = np.zeros_like(self.s)
         self.wdx = w[None, :] * lengths[:, None] / 2.0
         N, dN, ddN = hermite(self.s, lengths)
+        self.dN, self.ddN = np.ascontiguousarray(dN), np.ascontiguousarray(ddN)
         self.S = hermite_operator(N, dof_map, n_edof)
         self.Ba = hermite_operator(dN, dof_map, n_edof)
         self.Bb = hermite_operator(ddN, dof_map, n_edof)

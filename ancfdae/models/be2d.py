@@ -14,34 +14,16 @@ exact, for all elements and points in a few ``einsum`` calls.
 """
 from __future__ import annotations
 
-import importlib.util
-
 import numpy as np
 
 from .._validate import choice, positive_int
 from ..materials import Material
 from ._element import Element
+from ._kernel_option import resolve_kernel
 from ._quadrature import gauss
 from ._shapes import hermite
 
 __all__ = ["BE2D"]
-
-KERNELS = ("auto", "numpy", "numba")
-
-
-def _numba_available() -> bool:
-    return importlib.util.find_spec("numba") is not None
-
-
-def _resolve_kernel(kernel: str) -> str:
-    """The implementation behind a ``kernel`` option: "numpy" or "numba"."""
-    kernel = choice("kernel", kernel, KERNELS)
-    if kernel == "auto":
-        return "numba" if _numba_available() else "numpy"
-    if kernel == "numba" and not _numba_available():
-        raise ImportError("`kernel` 'numba' needs numba, which is not installed; install it with "
-                          "`pip install \"ancfdae[fast]\"` or use kernel='auto' or 'numpy'.")
-    return kernel
 
 # (r' x r'').e_z = r'^T P r''
 _P = np.array([[0.0, 1.0], [-1.0, 0.0]])
@@ -82,10 +64,9 @@ class BE2D(Element):
         Implementation of :meth:`internal_forces`. ``"numpy"``: vectorised
         NumPy, the reference. ``"numba"``: one compiled loop over elements x
         points (:mod:`ancfdae.models._be2d_numba`, same results to rounding;
-        needs the optional dependency numba, ``pip install "ancfdae[fast]"``;
         the first call compiles, or loads the on-disk cache). ``"auto"``
-        (default): numba when importable, else NumPy. Settable later through
-        the ``kernel`` attribute.
+        (default): numba (a dependency of ancfdae) when importable, else
+        NumPy. Settable later through the ``kernel`` attribute.
     """
 
     name = "BE2D"
@@ -115,9 +96,8 @@ class BE2D(Element):
 
     @kernel.setter
     def kernel(self, value):
-        self._impl = _resolve_kernel(value)
+        self._impl = resolve_kernel(value)
         self._kernel = value
-        self._compiled = None
 
     @property
     def kernel_in_use(self) -> str:
@@ -286,20 +266,30 @@ class BE2D(Element):
         K = A @ B + (first @ geom["d2"]).reshape(n_el, 8, 8)
         return f, K
 
-    def _internal_forces_numba(self, geom, q, tangent):
-        """The compiled kernel; imported (and numba with it) on first use."""
-        if self._compiled is None:
-            from . import _be2d_numba as nb
+    def _numba_args(self, geom):
+        """The compiled module and the kernel's arguments after ``q`` (cached in the geometry)."""
+        hit = geom.get("_numba")
+        if hit is None:   # C-contiguous float copies for the compiled loop, once per geometry
+            from . import _be2d_numba as nb   # imports numba: only once the compiled kernel is selected
             form = nb.STRUCTURAL if self.formulation == "structural" else nb.CONTINUUM
             E, sec = self.material.E, self.section
-            self._compiled = (nb.be2d_forces, form, E * sec.A, E, sec.I3, sec.I4)
-        fn, form, EA, E, I, I4 = self._compiled
-        nbg = geom.get("_numba")
-        if nbg is None:   # C-contiguous float copies for the compiled loop, once per geometry
-            nbg = geom["_numba"] = tuple(np.ascontiguousarray(geom[k], dtype=float)
-                                         for k in ("dN_e", "ddN_e", "w", "eps_ref", "K_ref"))
-        f, K = fn(np.ascontiguousarray(q, dtype=float), *nbg, geom["n_a"], form, EA, E, I, I4, bool(tangent))
+            args = tuple(np.ascontiguousarray(geom[k], dtype=float)
+                         for k in ("dN_e", "ddN_e", "w", "eps_ref", "K_ref")) + (
+                geom["n_a"], form, E * sec.A, E, sec.I3, sec.I4)
+            hit = geom["_numba"] = (nb, args, (nb.be2d_fused, args))
+        return hit
+
+    def _internal_forces_numba(self, geom, q, tangent):
+        """The compiled kernel; imported (and numba with it) on first use."""
+        nb, args, _ = self._numba_args(geom)
+        f, K = nb.be2d_forces(np.ascontiguousarray(q, dtype=float), *args, bool(tangent))
         return f, (K if tangent else None)
+
+    def fused_kernel(self, geom):
+        """``(be2d_fused, args)`` with the compiled kernel selected, else None (see :class:`Element`)."""
+        if self._impl != "numba":
+            return None
+        return self._numba_args(geom)[2]
 
     def shape_matrix(self, s, lengths):
         N, _, _ = hermite(np.asarray(s, dtype=float), lengths)

@@ -11,9 +11,10 @@ from __future__ import annotations
 import numpy as np
 
 from .._validate import choice, finite_vector, positive_int
-from ._be3d_dynamics import UPDATES, rotary_inertia, rotary_kinetic_energy, update_directors
+from ._be3d_dynamics import UPDATES, director_sines, rotary_inertia, rotary_kinetic_energy, update_directors
 from ._be3d_kinematics import curvature_energy, curvatures, director_field, frames, spin_gradient
 from ._element import Element
+from ._kernel_option import resolve_kernel
 from ._scalar_jet import Jet
 from ._shapes import hermite, linear
 from ._thin import (PointRule, assemble, axial_energy, check_material_section, clamp_coordinates,
@@ -63,8 +64,9 @@ class BE3D(Element):
     section : RectangularSection or CircularSection
         Uses ``A``, ``I2``, ``I3``, ``J = I2 + I3`` and ``k_t``.
     director_update : {"projected", "post-rotated", "none"}
-        Update of the nodal directors after each accepted step (Sect. 3.6),
-        done by :meth:`accept_step`. With ``"post-rotated"`` the update is
+        Update of the nodal directors after an accepted step (Sect. 3.6): a
+        model event (:meth:`step_event`); the directors are the beam's event
+        state, carried by the driver and kept in ``Result.model_state``. With ``"post-rotated"`` the update is
         also applied to the reference configuration (director ``e3``,
         ``theta = 0``), so that the values fixed by supports stay valid.
     director : array_like (3,), optional
@@ -73,6 +75,19 @@ class BE3D(Element):
     axial_points, bending_points, inertia_points : int
         Gauss points of the axial term, of the bending and torsion terms,
         and of the rotary kinetic energy.
+    update_below : float in (0, 1], optional
+        Update the directors only when at some node the sine of the angle
+        between director and axis (the norm of the projection of Eq. 99 of
+        the unit director) falls below this value; None (default) updates
+        after every step, as the chapter does.
+    kernel : {"auto", "numpy", "numba"}
+        Implementation of the strain energy, internal forces and rotary
+        inertia. ``"numba"``: compiled loops over elements x points
+        (:mod:`._be3d_numba`, :mod:`._be3d_inertia_numba`; the first call
+        compiles or loads the on-disk cache). ``"numpy"``: vectorised NumPy,
+        the readable reference (same results to rounding). ``"auto"``
+        (default): numba when importable. Settable later through the
+        ``kernel`` attribute.
     """
 
     name = "BE3D"
@@ -82,11 +97,16 @@ class BE3D(Element):
     mass_is_constant = False
 
     def __init__(self, material, section, director_update: str = "projected", director=None,
-                 axial_points: int = 5, bending_points: int = 3, inertia_points: int = 3):
+                 axial_points: int = 5, bending_points: int = 3, inertia_points: int = 3,
+                 update_below: float | None = None, kernel: str = "auto"):
         check_material_section(material, section, ("A", "I2", "I3", "J", "k_t"))
         self.material = material
         self.section = section
         self.director_update = choice("director_update", director_update, UPDATES)
+        if update_below is not None and (isinstance(update_below, bool) or not isinstance(update_below, (int, float))
+                                         or not 0.0 < update_below <= 1.0):
+            raise ValueError(f"`update_below` must be None or a number in (0, 1], got {update_below!r}.")
+        self.update_below = None if update_below is None else float(update_below)
         if director is not None:
             director = finite_vector("director", director, 3)
             if not np.linalg.norm(director) > 0:
@@ -101,10 +121,27 @@ class BE3D(Element):
         self.rhoA = material.rho * section.A
         self.rhoJ = material.rho * section.J
         self._pending = None
+        self.kernel = kernel
+
+    @property
+    def kernel(self) -> str:
+        """The ``kernel`` option as given ("auto", "numpy" or "numba")."""
+        return self._kernel
+
+    @kernel.setter
+    def kernel(self, value):
+        self._impl = resolve_kernel(value)
+        self._kernel = value
+
+    @property
+    def kernel_in_use(self) -> str:
+        """The implementation that runs: "numpy" or "numba"."""
+        return self._impl
 
     def __repr__(self):
         return (f"BE3D(director_update={self.director_update!r}, axial_points={self.axial_points}, "
-                f"bending_points={self.bending_points}, inertia_points={self.inertia_points})")
+                f"bending_points={self.bending_points}, inertia_points={self.inertia_points}, "
+                f"kernel={self._kernel!r})")
 
     # -- mesh -------------------------------------------------------------
     def reference_coordinates(self, points, frames_):
@@ -157,7 +194,9 @@ class BE3D(Element):
         self._pending = None
         if D is None or D.shape[0] != n_el + 1:
             D = self._fallback_directors(q_ref)
-        geom = {"L": lengths, "directors": np.array(D, dtype=float),
+        D = np.array(D, dtype=float)
+        D.setflags(write=False)   # event state: replaced (Beam.bind), never changed in place
+        geom = {"L": lengths, "directors": D,
                 "axial": PointRule(self.axial_points, lengths, _DOF, _NDOF),
                 "bend": self._rule(self.bending_points, lengths),
                 "inertia": self._rule(self.inertia_points, lengths),
@@ -213,12 +252,25 @@ class BE3D(Element):
         """Constant part ``rho A int S^T S dxi`` (zero rows and columns for theta)."""
         return geom["M"]
 
+    def _compiled_forces(self, geom, q, tangent):
+        """(U, f, K) from the compiled kernel, with the nodal directors of ``geom``."""
+        from ._be3d_numba import be3d_forces
+        ax, bd = geom["axial"], geom["bend"]
+        return be3d_forces(np.ascontiguousarray(q, dtype=float), _DOF, _THETA, ax.dN, ax.wdx, geom["slope_ref"],
+                           bd.dN, bd.ddN, bd.wdx, bd.lin, geom["L"], np.ascontiguousarray(geom["directors"]),
+                           geom["k_ref"], self.D, self.EA, bool(tangent))
+
     def strain_energy(self, geom, q):
+        if self._impl == "numba":
+            return self._compiled_forces(geom, q, False)[0]
         U, _, _ = axial_energy(geom["axial"], q, geom["slope_ref"], self.EA, False)
         W, _ = curvature_energy(*self._local(geom, q, geom["bend"]), geom["k_ref"], self.D)
         return U + np.sum(geom["bend"].wdx * W, axis=1)
 
     def internal_forces(self, geom, q, tangent=True):
+        if self._impl == "numba":
+            _, f, K = self._compiled_forces(geom, q, tangent)
+            return f, (K if tangent else None)
         _, f, K = axial_energy(geom["axial"], q, geom["slope_ref"], self.EA, tangent)
         rule = geom["bend"]
         if not tangent:
@@ -255,6 +307,12 @@ class BE3D(Element):
         ``f_r' = (M x e1)/|r'| + g (M . e1)`` and ``f_theta = M . e1``.
         """
         M = finite_vector("moment", moment, 3)
+        if self._impl == "numba":
+            from ._be3d_moment_numba import be3d_moment
+            D = geom["directors"]
+            f, K = be3d_moment(np.ascontiguousarray(q, dtype=float), _DOF, _THETA, float(s), float(geom["L"][element]),
+                               np.ascontiguousarray(D[element]), np.ascontiguousarray(D[element + 1]), M, bool(tangent))
+            return f, (K if tangent else None)
         L = geom["L"][[element]]
         s_ = np.array([float(s)])
         _, dN, _ = hermite(s_, L)
@@ -291,16 +349,50 @@ class BE3D(Element):
         :mod:`._be3d_dynamics`). Returns ``(f, None, None, None)`` when
         ``jacobian`` is False.
         """
+        if self._impl == "numba":
+            from ._be3d_inertia_numba import be3d_inertia
+            rule = geom["inertia"]
+            f, Kq, Dv, Ma = be3d_inertia(*(np.ascontiguousarray(x, dtype=float) for x in (q, v, a)), _DOF, _THETA,
+                                         rule.dN, rule.wdx, rule.lin, np.ascontiguousarray(geom["directors"]),
+                                         self.rhoJ, bool(jacobian))
+            return (f, Kq, Dv, Ma) if jacobian else (f, None, None, None)
         return rotary_inertia(geom["inertia"], geom, q, v, a, self.rhoJ, jacobian)
 
     def kinetic_energy_extra(self, geom, q, v):
         """``1/2 int rho J omega1^2 dxi`` per element."""
+        if self._impl == "numba":
+            from ._be3d_inertia_numba import be3d_kinetic_energy
+            rule = geom["inertia"]
+            return be3d_kinetic_energy(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(v, dtype=float),
+                                       _DOF, _THETA, rule.dN, rule.wdx, rule.lin,
+                                       np.ascontiguousarray(geom["directors"]), self.rhoJ)
         return rotary_kinetic_energy(geom["inertia"], geom, q, v, self.rhoJ)
 
-    def accept_step(self, geom, Q, V):
-        """Director update of Sect. 3.6 (``director_update``); see :func:`._be3d_dynamics.update_directors`."""
-        return update_directors(geom, np.asarray(Q, dtype=float), np.asarray(V, dtype=float),
-                                self.director_update)
+    def event_state(self, geom) -> dict:
+        """``{"directors": (n_nodes, 3)}``: the nodal directors, carried by the driver between steps."""
+        return {"directors": geom["directors"]}
+
+    def bind(self, geom, state) -> dict:
+        """``geom`` with the nodal directors of ``state`` (read-only; ``geom`` itself is unchanged)."""
+        D = np.array(state["directors"], dtype=float)
+        if D.shape != geom["directors"].shape:
+            raise ValueError(f"`state['directors']` must have shape {geom['directors'].shape}, got {D.shape}.")
+        D.setflags(write=False)
+        return dict(geom, directors=D)
+
+    def step_event(self, geom, Q, V):
+        """Director update of Sect. 3.6 (``director_update``, ``update_below``); None when not done.
+
+        See :func:`._be3d_dynamics.update_directors`.
+        """
+        if self.director_update == "none":
+            return None
+        D = geom["directors"]
+        Q = np.asarray(Q, dtype=float)
+        if self.update_below is not None and np.min(director_sines(D, Q)) >= self.update_below:
+            return None
+        Q2, V2, D2 = update_directors(D, Q, np.asarray(V, dtype=float), self.director_update)
+        return Q2, V2, {"directors": D2}
 
 
 def _check_director(d, e1):

@@ -8,19 +8,38 @@ its iteration matrix by combining data arrays.
 """
 from __future__ import annotations
 
+import copy
+import functools
 import numbers
+from collections.abc import Iterable, Mapping
 
 import numpy as np
 import scipy.sparse as sp
 
+from .._validate import check_shape
 from ..loads import DistributedLoad, Gravity, PointForce, PointMoment
 from ..problem import Energy, JacobianBlocks
+from . import _describe
 from ._assembly import Assembler
 from ._element import Element
 from ._mesh import mesh_from_points, straight_mesh
 from ._quadrature import gauss
 
 __all__ = ["Beam"]
+
+
+@functools.cache
+def _finish_residual():
+    """The compiled ``f + M a - lambda f_ext`` (imports numba: only reached on the fused path)."""
+    from ._assembly_numba import finish_residual
+    return finish_residual
+
+
+@functools.cache
+def _finish_stages():
+    """The compiled stage version of :func:`_finish_residual`."""
+    from ._assembly_numba import finish_stages
+    return finish_stages
 
 
 class Beam:
@@ -48,8 +67,9 @@ class Beam:
     supports : dict, optional
         ``{node: kind}`` with kind ``"clamp"``, ``"pin"`` or a tuple of
         coordinate names of ``element.node_coordinates`` to fix. Negative
-        node indices count from the end.
-    loads : sequence, optional
+        node indices count from the end. Without supports the beam flies
+        freely (dynamics); a static solve then fails (singular stiffness).
+    loads : load or sequence of loads, optional
         :class:`~ancfdae.loads.PointForce`, :class:`~ancfdae.loads.PointMoment`,
         :class:`~ancfdae.loads.Gravity`, :class:`~ancfdae.loads.DistributedLoad`.
     initial_velocity : callable or array_like, optional
@@ -72,6 +92,7 @@ class Beam:
         if not isinstance(element, Element):
             raise TypeError(f"`element` must be an ancfdae element (e.g. BE2D(...)), got {element!r}.")
         self.element = element
+        self.normal = normal   # kept for describe()
         dim = element.dim
         npe = element.n_nodes
         if nodes is not None:
@@ -106,8 +127,14 @@ class Beam:
 
         # Supports: eliminate fixed coordinates.
         fixed = np.zeros(self.q_ref.size, dtype=bool)
+        if supports is not None and not isinstance(supports, Mapping):
+            raise TypeError(f"`supports` must be a dict {{node: kind}} with kind 'clamp', 'pin' or a tuple of "
+                            f"coordinate names, e.g. {{0: 'clamp'}}; got {supports!r}.")
         for node, kind in (supports or {}).items():
             i = self._node_index(node, "supports")
+            if not isinstance(kind, (str, tuple, list)):
+                raise ValueError(f"`supports` kind must be 'clamp', 'pin' or a tuple of coordinate names "
+                                 f"{element.node_coordinates}, got {kind!r} at node {node}.")
             if isinstance(kind, str):
                 if kind not in ("clamp", "pin"):
                     raise ValueError(f"`supports` kind must be 'clamp', 'pin' or a tuple of coordinate names "
@@ -133,13 +160,42 @@ class Beam:
         self._M_csr = self._asm.csr(self._M_data)   # constant-mass product M a, built once
         self._zero_data = np.zeros(self._asm.nnz)
         self.load_factor = 1.0
-        self._setup_loads(loads)
+        if isinstance(loads, (PointForce, PointMoment, Gravity, DistributedLoad)):
+            loads = (loads,)   # a single load is a sequence of one
+        elif loads is None:
+            loads = ()
+        elif not isinstance(loads, Iterable):
+            raise TypeError(f"`loads` must be a load or a sequence of loads (PointForce, PointMoment, Gravity, "
+                            f"DistributedLoad), got {loads!r}.")
+        self.loads = tuple(loads)   # kept for describe()
+        self._setup_loads(self.loads)
         # Gather of the element coordinates from (free q, fixed reference values) in one take.
         ext_of_full = free_of_full.copy()
         ext_of_full[fixed] = self.n_dof + np.arange(int(fixed.sum()))
         self._q_fixed = self.q_ref[fixed].copy()
         self._gather = ext_of_full[self.edofs]
         self._v0 = self._initial_velocity(initial_velocity)
+        self._no_k = np.empty(1)
+        self.assembly = "fused"
+
+    @property
+    def assembly(self) -> str:
+        """Assembly path: "fused" (default) or "numpy".
+
+        ``"fused"``: with an element that offers a compiled kernel
+        (:meth:`ancfdae.models._element.Element.fused_kernel`), gather, kernel
+        and scatter into the fixed CSR data run as one compiled call per
+        evaluation; otherwise (and with ``"numpy"``, the readable reference) the
+        element kernel returns element arrays that ``np.bincount`` sums. Both
+        give the same bits for the same kernel.
+        """
+        return self._assembly
+
+    @assembly.setter
+    def assembly(self, value):
+        if value not in ("fused", "numpy"):
+            raise ValueError(f"`assembly` must be 'fused' or 'numpy', got {value!r}.")
+        self._assembly = value
 
     # -- geometry helpers -------------------------------------------------
     def _node_index(self, node, arg):
@@ -191,8 +247,19 @@ class Beam:
 
     def position(self, q: np.ndarray, s) -> np.ndarray:
         """Axis position at reference arc length ``s`` (scalar -> (dim,), array -> (n, dim))."""
+        self._check(q)
         r = (self.point_matrix(s) @ self.expand(q)).reshape(-1, self.element.dim)
         return r[0] if np.ndim(s) == 0 else r
+
+    def describe(self) -> dict:
+        """JSON-able description (element, material, section, mesh, supports, loads); see
+        :func:`ancfdae.models._describe.describe`."""
+        return _describe.describe(self)
+
+    def dof_labels(self) -> tuple[np.ndarray, np.ndarray]:
+        """Node index and coordinate name of each free coordinate; see
+        :func:`ancfdae.models._describe.dof_labels`."""
+        return _describe.dof_labels(self)
 
     # -- loads ------------------------------------------------------------
     def _setup_loads(self, loads):
@@ -255,6 +322,18 @@ class Beam:
         return f, kdata
 
     # -- the Model contract -------------------------------------------------
+    def _check(self, q, v=None, a=None):
+        """Shape checks of the contract's arguments: a wrong length would otherwise assemble silently
+        into a wrong-sized residual or fail deep inside numpy."""
+        n = (self.n_dof,)
+        # Attribute access for arrays (tens of ns); anything else goes through np.shape in check_shape.
+        if getattr(q, "shape", None) != n:
+            check_shape("q", q, n, f"n_dof = {self.n_dof}")
+        if v is not None and getattr(v, "shape", None) != n:
+            check_shape("v", v, n, f"n_dof = {self.n_dof}")
+        if a is not None and getattr(a, "shape", None) != n:
+            check_shape("a", a, n, f"n_dof = {self.n_dof}")
+
     def initial_state(self):
         """Reference configuration and the initial velocity."""
         return self.q_ref[self.free].copy(), self._v0.copy()
@@ -284,6 +363,8 @@ class Beam:
 
     def mass(self, q=None) -> sp.csr_matrix:
         """Mass matrix M(q) (constant unless the element says otherwise; ``q=None``: the reference state)."""
+        if q is not None:
+            self._check(q)
         if self.mass_is_constant:
             return self._asm.csr(self._M_data.copy())
         if q is None:
@@ -306,23 +387,56 @@ class Beam:
     def _f_external(self, t, q, tangent):
         """``fnc + f_gravity`` (free vector) and the load tangent data (or None); skips the
         non-conservative pass when the beam has no such loads (bit-for-bit: 0 + f_g = f_g)."""
-        if not self._dead and not self._moments:
-            return self._f_gravity, None
+        if not self._moments:
+            if not self._dead:
+                return self._f_gravity, None
+            time, vec = self._dead[0]
+            f = time(t) * vec
+            for time, vec in self._dead[1:]:
+                f += time(t) * vec
+            return f + self._f_gravity, None
         fnc, kload = self._f_nonconservative(t, self.expand(q), tangent)
         return fnc + self._f_gravity, kload
 
+    def _fused(self, geom):
+        """The element's fused entry point ``(fn, args)`` for ``geom``, or None (NumPy assembly)."""
+        return self.element.fused_kernel(geom) if self._assembly == "fused" else None
+
     def internal_forces(self, q, tangent=True):
         """Assembled ``dU/dq`` (free vector) and tangent CSR data (or None)."""
-        fe, ke = self.element.internal_forces(self.geom, self._element_q(q), tangent)
-        return self._asm.vector(fe), (self._asm.data(ke) if tangent else None)
+        return self._assemble(q, tangent)[:2]
+
+    def _assemble(self, q, tangent):
+        """``(f, kdata, fused)``: assembled ``dU/dq``, tangent data or None, and which path ran."""
+        fused = self._fused(self.geom)
+        if fused is None:
+            fe, ke = self.element.internal_forces(self.geom, self._element_q(q), tangent)
+            return self._asm.vector(fe), (self._asm.data(ke) if tangent else None), False
+        fn, args = fused
+        n, nnz = self.n_dof, self._asm.nnz
+        r = np.empty(n + 1)
+        kd = np.empty(nnz + 1) if tangent else self._no_k
+        fn(np.ascontiguousarray(q, dtype=float), self._q_fixed, self._gather, self._asm._vec_all,
+           self._asm._slot_all, bool(tangent), r, kd, *args)
+        return r[:n], (kd[:nnz] if tangent else None), True
+
+    def _static_residual(self, a, f, fext, fused):
+        """``f + M a - lambda f_ext`` (in place in ``f`` on the fused path: the same rounding)."""
+        if fused:
+            _finish_residual()(f, self._M_data, self._asm.indptr, self._asm.indices,
+                            np.ascontiguousarray(a, dtype=float), float(self.load_factor),
+                            np.ascontiguousarray(fext, dtype=float))
+            return f
+        return f + self._M_csr @ a - self.load_factor * fext
 
     def residual(self, t, q, v, a):
         """``r = M(q) a + f_int(q) [+ inertia(q, v, a)] - lambda f_ext(t, q)``."""
-        fe, _ = self.element.internal_forces(self.geom, self._element_q(q), False)
-        r = self._asm.vector(fe) + self._M_csr @ a
+        self._check(q, v, a)
+        f, _, fused = self._assemble(q, False)
+        r = self._static_residual(a, f, self._f_external(t, q, False)[0], fused)
         if not self.mass_is_constant:
             r += self._inertia(q, v, a, False)[0]
-        return r - self.load_factor * self._f_external(t, q, False)[0]
+        return r
 
     def residual_stages(self, ts, Q, V, A):
         """Residuals of several stages in one element pass: column ``i`` of the (n_dof, m) result is
@@ -331,24 +445,53 @@ class Beam:
         The element kernel runs once on the stages' elements stacked (a geometry for ``m`` copies of
         the mesh, prepared on first use), which halves the per-call overhead of small meshes.
         """
+        m = np.size(ts)
+        if np.ndim(ts) != 1 or np.shape(Q) != (self.n_dof, m) or np.shape(V) != (self.n_dof, m) \
+                or np.shape(A) != (self.n_dof, m):
+            check_shape("ts", ts, (m,), "one time per stage")
+            for name, X in (("Q", Q), ("V", V), ("A", A)):
+                check_shape(name, X, (self.n_dof, m), f"(n_dof, number of stages) = ({self.n_dof}, {m})")
         ts = np.asarray(ts, dtype=float)
         m = ts.size
         if not self.mass_is_constant:
             return np.column_stack([self.residual(ts[i], Q[:, i], V[:, i], A[:, i]) for i in range(m)])
         geom, gather, idx = self._stage_geometry(m)
         n = self.n_dof
-        ext = np.empty((n + self._q_fixed.size, m))   # (free q; fixed values) per stage, stage fastest
-        ext[:n] = Q
-        ext[n:] = self._q_fixed[:, None]
-        fe, _ = self.element.internal_forces(geom, ext.ravel().take(gather), False)
-        F = np.bincount(idx, weights=fe.ravel(), minlength=m * (n + 1)).reshape(m, n + 1)[:, :n].T
-        R = F + self._M_csr @ A
+        fused = self._fused(geom)
+        if fused is None:
+            ext = np.empty((n + self._q_fixed.size, m))   # (free q; fixed values) per stage, stage fastest
+            ext[:n] = Q
+            ext[n:] = self._q_fixed[:, None]
+            fe, _ = self.element.internal_forces(geom, ext.ravel().take(gather), False)
+            F = np.bincount(idx, weights=fe.ravel(), minlength=m * (n + 1))
+            F = F.reshape(m, n + 1)[:, :n].T
+            R = F + self._M_csr @ A
+            if not self._dead and not self._moments:
+                R -= self.load_factor * self._f_gravity[:, None]
+            else:
+                for i in range(m):
+                    R[:, i] -= self.load_factor * self._f_external(ts[i], Q[:, i], False)[0]
+            return R
+        fn, args = fused
+        F = np.empty((m, n + 1))
+        q_fixed_m, gravity_m = self._stage_constants(m)
+        fn(np.ascontiguousarray(Q, dtype=float).reshape(-1), q_fixed_m, gather, idx,
+           self._asm._slot_all, False, F.reshape(-1), self._no_k, *args)
         if not self._dead and not self._moments:
-            R -= self.load_factor * self._f_gravity[:, None]
+            fext = gravity_m
         else:
-            for i in range(m):
-                R[:, i] -= self.load_factor * self._f_external(ts[i], Q[:, i], False)[0]
+            fext = np.column_stack([self._f_external(ts[i], Q[:, i], False)[0] for i in range(m)])
+        R = np.empty((n, m))
+        _finish_stages()(F, self._M_data, self._asm.indptr, self._asm.indices, np.ascontiguousarray(A, dtype=float),
+                         float(self.load_factor), fext, R)
         return R
+
+    def _stage_constants(self, m):
+        """The fixed coordinates repeated per stage and the gravity force per stage, (n, m) (cached)."""
+        cache = self.__dict__.setdefault("_stage_const", {})
+        if m not in cache:
+            cache[m] = (np.repeat(self._q_fixed, m), np.repeat(self._f_gravity[:, None], m, axis=1))
+        return cache[m]
 
     def _stage_geometry(self, m):
         """Element geometry of ``m`` stacked copies of the mesh and the matching scatter index."""
@@ -364,10 +507,10 @@ class Beam:
 
     def residual_jacobian(self, t, q, v, a):
         """``(residual, jacobian)`` from one kernel pass (the fused path of full Newton)."""
-        fe, ke = self.element.internal_forces(self.geom, self._element_q(q), True)
+        self._check(q, v, a)
+        f, K, fused = self._assemble(q, True)
         fext, kload = self._f_external(t, q, True)
-        r = self._asm.vector(fe) + self._M_csr @ a - self.load_factor * fext
-        K = self._asm.data(ke)
+        r = self._static_residual(a, f, fext, fused)
         if kload is not None:
             K -= self.load_factor * kload
         D, M = self._zero_data, self._M_data
@@ -380,8 +523,8 @@ class Beam:
 
     def jacobian(self, t, q, v, a) -> JacobianBlocks:
         """Exact ``dr/dq``, ``dr/dv``, ``dr/da`` with one shared CSR pattern."""
-        _, ke = self.element.internal_forces(self.geom, self._element_q(q), True)
-        K = self._asm.data(ke)
+        self._check(q, v, a)
+        _, K = self.internal_forces(q, True)
         kload = self._f_external(t, q, True)[1] if self._moments else None
         if kload is not None:
             K -= self.load_factor * kload
@@ -394,6 +537,7 @@ class Beam:
 
     def energy(self, t, q, v) -> Energy:
         """Kinetic ``1/2 v^T M v`` (+ element extra), strain, gravity potential."""
+        self._check(q, v)
         T = 0.5 * v @ (self._M_csr @ v)
         if not self.mass_is_constant:
             qf, vf = self.expand(q), self._expand_v(v)
@@ -405,12 +549,35 @@ class Beam:
 
     def external_power(self, t, q, v) -> float:
         """Power of all loads except gravity (whose work is the potential)."""
+        self._check(q, v)
         f, _ = self._f_nonconservative(t, self.expand(q), False)
         return float(self.load_factor * f @ v)
 
-    def accept_step(self, t, q, v):
-        """Element hook after an accepted step (BE3D director update); identity otherwise."""
-        if type(self.element).accept_step is Element.accept_step:
-            return q, v
-        Q, V = self.element.accept_step(self.geom, self.nodal(q), self._expand_v(v).reshape(self.n_nodes, -1))
-        return Q.reshape(-1)[self.free], V.reshape(-1)[self.free]
+    # -- capabilities and event state (ancfdae.problem.CAPABILITIES) --------------------------
+    @property
+    def capabilities(self) -> frozenset:
+        """The optional capabilities this beam offers (see :func:`ancfdae.problem.capabilities`)."""
+        caps = {"residual_jacobian", "residual_stages"}
+        if not self.mass_is_constant:
+            caps.add("variable_mass")
+        if self.element.event_state(self.geom):
+            caps.add("step_events")
+        return frozenset(caps)
+
+    def event_state(self) -> dict:
+        """The element's event state (BE3D: ``{"directors": (n_nodes, 3)}``), read-only arrays."""
+        return dict(self.element.event_state(self.geom))
+
+    def bind(self, state: dict) -> "Beam":
+        """A beam evaluating with the event ``state``, sharing everything else (this one is unchanged)."""
+        other = copy.copy(self)
+        other.geom = self.element.bind(self.geom, state)
+        return other
+
+    def step_event(self, t, q, v):
+        """The element's event after an accepted step (BE3D director update); None when nothing changed."""
+        ev = self.element.step_event(self.geom, self.nodal(q), self._expand_v(v).reshape(self.n_nodes, -1))
+        if ev is None:
+            return None
+        Q, V, state = ev
+        return Q.reshape(-1)[self.free], V.reshape(-1)[self.free], state

@@ -11,6 +11,7 @@ import numpy as np
 
 from .._validate import finite_vector, positive_int
 from ._element import Element
+from ._kernel_option import resolve_kernel
 from ._shapes import hermite
 from ._thin import (PointRule, assemble, axial_energy, check_material_section, clamp_coordinates,
                     hermite_operator, translational_mass)
@@ -60,6 +61,13 @@ class Cable3D(Element):
     axial_points, bending_points : int
         Gauss points of the axial and the bending term; the defaults 5 and 3
         (orders 9 and 5, as for BE2D) reproduce the chapter's Table 2.
+    kernel : {"auto", "numpy", "numba"}
+        Implementation of :meth:`strain_energy` and :meth:`internal_forces`.
+        ``"numba"``: one compiled loop over elements x points
+        (:mod:`ancfdae.models._cable3d_numba`; the first call compiles or loads
+        the on-disk cache). ``"numpy"``: vectorised NumPy, the readable
+        reference (same results to rounding). ``"auto"`` (default): numba when
+        importable. Settable later through the ``kernel`` attribute.
     """
 
     name = "Cable3D"
@@ -67,7 +75,7 @@ class Cable3D(Element):
     node_params = (-1.0, 1.0)
     node_coordinates = ("x", "y", "z", "x'", "y'", "z'")
 
-    def __init__(self, material, section, axial_points: int = 5, bending_points: int = 3):
+    def __init__(self, material, section, axial_points: int = 5, bending_points: int = 3, kernel: str = "auto"):
         check_material_section(material, section, ("A", "I2", "I3"))
         if not np.isclose(section.I2, section.I3, rtol=_SYM_RTOL, atol=0.0):
             raise ValueError("`section` of a Cable3D must have a symmetric bending stiffness (I2 == I3, chapter "
@@ -77,9 +85,26 @@ class Cable3D(Element):
         self.section = section
         self.axial_points = positive_int("axial_points", axial_points)
         self.bending_points = positive_int("bending_points", bending_points)
+        self.kernel = kernel
+
+    @property
+    def kernel(self) -> str:
+        """The ``kernel`` option as given ("auto", "numpy" or "numba")."""
+        return self._kernel
+
+    @kernel.setter
+    def kernel(self, value):
+        self._impl = resolve_kernel(value)
+        self._kernel = value
+
+    @property
+    def kernel_in_use(self) -> str:
+        """The implementation that runs: "numpy" or "numba"."""
+        return self._impl
 
     def __repr__(self):
-        return f"Cable3D(axial_points={self.axial_points}, bending_points={self.bending_points})"
+        return (f"Cable3D(axial_points={self.axial_points}, bending_points={self.bending_points}, "
+                f"kernel={self._kernel!r})")
 
     # -- mesh -------------------------------------------------------------
     def reference_coordinates(self, points, frames):
@@ -122,13 +147,26 @@ class Cable3D(Element):
     def mass_matrix(self, geom):
         return geom["M"]
 
+    def _compiled(self, geom, q, tangent):
+        """(U, f, K) from the compiled kernel; numba is imported on first use."""
+        from ._cable3d_numba import cable3d_forces
+        ax, bd = geom["axial"], geom["bend"]
+        return cable3d_forces(np.ascontiguousarray(q, dtype=float), _DOF, ax.dN, ax.wdx, geom["slope_ref"],
+                              bd.dN, bd.ddN, bd.wdx, self.material.E * self.section.A,
+                              self.material.E * self.section.I3, bool(tangent))
+
     def strain_energy(self, geom, q):
+        if self._impl == "numba":
+            return self._compiled(geom, q, False)[0]
         U, _, _ = axial_energy(geom["axial"], q, geom["slope_ref"], self.material.E * self.section.A, False)
         rule = geom["bend"]
         K2 = self._curvature_squared(rule, q)
         return U + 0.5 * self.material.E * self.section.I3 * np.sum(rule.wdx * K2, axis=1)
 
     def internal_forces(self, geom, q, tangent=True):
+        if self._impl == "numba":
+            _, f, K = self._compiled(geom, q, tangent)
+            return f, (K if tangent else None)
         _, f, K = axial_energy(geom["axial"], q, geom["slope_ref"], self.material.E * self.section.A, tangent)
         rule = geom["bend"]
         EI = self.material.E * self.section.I3

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._jet import combine, linear, mul, recip, sqrt, dot, variables
-from ._sq_common import SQElement
+from ._sq_common import SQElement, shear_factors
 
 __all__ = ["SQ2D"]
 
@@ -25,17 +25,19 @@ class SQ2D(SQElement):
     ----------
     material : Material
     section : RectangularSection or CircularSection
-        Structural: ``A``, ``I3`` (in-plane bending), ``k_s(material)``.
+        Structural: ``A``, ``I3`` (in-plane bending) and the shear factor
+        ``k2`` of the shear along eta (``section.shear_factors_of(material)[0]``,
+        i.e. ``k_s`` unless ``shear_factors=(k2, k3)`` is given).
     formulation : {"structural", "continuum", "continuum-locking"}
         ``"structural"`` (Sect. 4.2.2): the frame of the cross-section slope,
         ``e_2 = a/|a|``, ``e_1 = e_2 x e_z`` with ``a = x_eta`` (the planar
         analogue of Eq. 7); generalised strains ``Gamma_1 = e_1.r' - 1``,
         ``Gamma_2 = e_2.r'`` (Eq. 16), curvature ``kappa = (a x a').e_z/|a|^2``
         (Eqs. 19, 25) and thickness strain ``E_22 = (a.a - 1)/2`` (Eq. 50), with
-        ``U = 1/2 int EA Gamma_1^2 + k_s GA Gamma_2^2 + EI kappa^2 + EA E_22^2
+        ``U = 1/2 int EA Gamma_1^2 + k2 GA Gamma_2^2 + EI kappa^2 + EA E_22^2
         dxi`` (Eqs. 109, 110).
         ``"continuum"`` (Sect. 4.2.1): Green strain and St. Venant-Kirchhoff,
-        plane stress, shear with ``k_s``, with the Poisson-locking remedy of
+        plane stress, shear with ``k2``, with the Poisson-locking remedy of
         Eq. 108 (Poisson part on the axis only). ``"continuum-locking"``: the
         same without the remedy (Poisson locking in bending).
     nodes : {3, 2}
@@ -45,6 +47,15 @@ class SQ2D(SQElement):
         ``"shear"``, ``"bending"``, ``"cross_section"``; continuum ``"axial"``,
         ``"section"``; each a number of Gauss points or
         ``("gauss"|"lobatto", n)``.
+    kernel : {"auto", "numpy", "numba"}
+        Implementation of the energy, forces and tangent. ``"numpy"``: the
+        vectorised NumPy kernels of :mod:`ancfdae.models._sq_kernels`, the
+        readable reference. ``"numba"``: one compiled loop over elements x
+        points (:mod:`ancfdae.models._sq_numba`, same results to rounding; the
+        first use compiles, about a minute on a loaded 2-core machine, then
+        loads from the on-disk cache in about a second). ``"auto"`` (default):
+        numba when importable, else NumPy. Settable later through the
+        ``kernel`` attribute; ``kernel_in_use`` says which one runs.
     """
 
     name = "SQ2D"
@@ -54,7 +65,8 @@ class SQ2D(SQElement):
 
     def _stiffness(self):
         m, s = self.material, self.section
-        return np.array([m.E * s.A, s.k_s(m) * m.G * s.A, m.E * s.I3, m.E * s.A])
+        k2 = shear_factors(s, m)[0]                 # shear along eta, the in-plane transverse direction
+        return np.array([m.E * s.A, k2 * m.G * s.A, m.E * s.I3, m.E * s.A])
 
     @staticmethod
     def _strains(p, which):

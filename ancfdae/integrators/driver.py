@@ -1,0 +1,257 @@
+"""The one driver loop around every integrator (the steppers of :mod:`.protocol`).
+
+:func:`integrate` owns everything that is not the step itself: validation of the run's arguments,
+the consistent initial acceleration, output times (grid hits and the stepper's interpolation inside
+a step), monitors (each step's :class:`~.protocol.Quadrature` is passed to ``Monitor.advance``),
+hooks, model events (the ``"step_events"`` capability of :mod:`ancfdae.problem`: BE3D's director
+update), failure handling and the :class:`~ancfdae.result.Result`.
+
+Failure handling: a failed step, a monitor asking to stop, or an exception raised by anything
+called during the run -- the model (e.g. a load's time function), a hook, a monitor, the stepper --
+ends the run with status "failed", the exception's type and text in ``message``, ``t_fail`` the
+last time reached and every output up to it. Exceptions are never propagated out of the loop;
+bad *arguments* still raise before the run starts.
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ancfdae import _validate as V
+from ancfdae.integrators._recorder import Recorder
+from ancfdae.problem import capabilities
+
+__all__ = ["check_model", "consistent_acceleration", "output_times", "integrate", "GRID_TOL",
+           "DEFAULT_MAX_STEPS"]
+
+_CONTRACT = ("initial_state", "mass", "residual", "jacobian")
+#: output times within this fraction of a step from the step's end are on the grid
+GRID_TOL = 1e-9
+#: default limit of accepted steps per run
+DEFAULT_MAX_STEPS = 10_000_000
+
+
+def check_model(model) -> int:
+    """Check that ``model`` offers the Model contract and valid capabilities; return ``n_dof``."""
+    missing = [m for m in _CONTRACT if not callable(getattr(model, m, None))]
+    if missing:
+        raise TypeError(f"`model` must implement the Model contract (ancfdae.problem.Model); "
+                        f"{type(model).__name__} lacks {missing}.")
+    n = getattr(model, "n_dof", None)
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise TypeError(f"`model.n_dof` must be a positive integer, got {n!r}.")
+    capabilities(model)
+    return int(n)
+
+
+def consistent_acceleration(model, t, q, v):
+    """Solve ``M(q) a = -r(t, q, v, 0)``; return ``(a, None)`` or ``(None, reason)``."""
+    rhs = -np.asarray(model.residual(t, q, v, np.zeros_like(q)), dtype=float)
+    M = model.mass(q)
+    try:
+        if sp.issparse(M):
+            a = spla.splu(sp.csc_matrix(M)).solve(rhs)
+        else:
+            a = np.linalg.solve(np.asarray(M, dtype=float), rhs)
+    except (RuntimeError, np.linalg.LinAlgError) as exc:
+        return None, f"mass matrix at t = {t:g} is singular ({exc})"
+    if not np.all(np.isfinite(a)):
+        return None, f"acceleration at t = {t:g} is not finite"
+    return a, None
+
+
+def output_times(t_span, t_eval):
+    """Validate ``t_span = (t0, tf)`` and ``t_eval``; return ``(t0, tf, t_out or None)``."""
+    try:
+        t0, tf = (float(x) for x in t_span)
+    except (TypeError, ValueError):
+        raise ValueError(f"`t_span` must be a pair (t0, tf) of numbers, got {t_span!r}.") from None
+    if not (np.isfinite(t0) and np.isfinite(tf)) or tf <= t0:
+        raise ValueError(f"`t_span` must satisfy t0 < tf (finite), got {t_span!r}.")
+    if t_eval is None:
+        return t0, tf, None
+    te = V.finite_vector("t_eval", t_eval)
+    if te.size == 0:
+        raise ValueError("`t_eval` must hold at least one time, got an empty array.")
+    if np.any(np.diff(te) <= 0):
+        raise ValueError("`t_eval` must be strictly increasing.")
+    if te[0] < t0 or te[-1] > tf:
+        raise ValueError(f"`t_eval` must lie within t_span [{t0}, {tf}], got [{te[0]}, {te[-1]}].")
+    return t0, tf, te
+
+
+def _initial_state(model, n, q0, v0, state0, events):
+    q_i, v_i = model.initial_state() if (q0 is None or v0 is None) else (None, None)
+    q0 = V.finite_vector("q0", q_i if q0 is None else q0, n).copy()
+    v0 = V.finite_vector("v0", v_i if v0 is None else v0, n).copy()
+    if not events:
+        if state0 is not None:
+            raise ValueError(f"`state0` is only for models with the 'step_events' capability; "
+                             f"{type(model).__name__} has no event state.")
+        return q0, v0, None
+    initial = model.event_state()
+    if state0 is None:
+        return q0, v0, initial
+    if not isinstance(state0, dict) or set(state0) != set(initial):
+        raise ValueError(f"`state0` must be a dict with the keys {sorted(initial)} (e.g. a row of "
+                         f"Result.model_state), got {state0!r:.200}.")
+    state = {}
+    for k, ref in initial.items():
+        arr = np.array(state0[k], dtype=float)
+        if arr.shape != np.shape(ref) or not np.all(np.isfinite(arr)):
+            raise ValueError(f"`state0[{k!r}]` must be finite with shape {np.shape(ref)}, got shape {arr.shape}.")
+        arr.setflags(write=False)
+        state[k] = arr
+    return q0, v0, state
+
+
+def _check_max_steps(stepper, t0, tf, max_steps):
+    if max_steps is None:
+        max_steps = DEFAULT_MAX_STEPS
+    max_steps = V.positive_int("max_steps", max_steps)
+    if getattr(stepper, "fixed_step", False) and stepper.h is not None:
+        need = (tf - t0) / stepper.h
+        if need > max_steps + GRID_TOL:
+            raise ValueError(f"a fixed step h = {stepper.h:g} over t_span = ({t0:g}, {tf:g}) needs "
+                             f"{math.ceil(need - GRID_TOL)} steps, more than max_steps = {max_steps}; "
+                             "use a larger h or raise max_steps.")
+    return max_steps
+
+
+class _Progress:
+    """A tqdm bar of simulated time with the step rate (only when asked for)."""
+
+    def __init__(self, enabled, t0, tf, label):
+        self.bar = None
+        if enabled:
+            from tqdm.auto import tqdm  # noqa: PLC0415 - optional display
+            self.bar = tqdm(total=tf - t0, unit="s(sim)", desc=label, leave=True,
+                            bar_format="{l_bar}{bar}| {n:.4g}/{total:.4g} s [{elapsed}<{remaining}{postfix}]")
+            self.t, self.wall, self.last = t0, time.perf_counter(), 0.0
+
+    def update(self, t, steps):
+        if self.bar is None:
+            return
+        self.bar.update(t - self.t)
+        self.t = t
+        now = time.perf_counter() - self.wall
+        if now - self.last > 0.5:
+            self.last = now
+            self.bar.set_postfix_str(f"{steps / max(now, 1e-9):.0f} steps/s", refresh=False)
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
+
+
+def integrate(stepper, model, t_span, t_eval=None, monitors=(), hooks=(), q0=None, v0=None, state0=None,
+              max_steps=None, progress=False):
+    """Run ``stepper`` (an :class:`~.protocol.Integrator`) on ``model`` over ``t_span``.
+
+    Parameters are those of :func:`ancfdae.simulate` (which builds the stepper); ``state0`` is the
+    model's event state to start from (a dict like one row of ``Result.model_state``).
+
+    Returns
+    -------
+    Result
+        Never raises once the run has started; see the module docstring.
+    """
+    n = check_model(model)
+    caps = capabilities(model)
+    events = "step_events" in caps
+    t0, tf, t_out = output_times(t_span, t_eval)
+    hooks = list(hooks or ())
+    for k in hooks:
+        if not callable(k):
+            raise TypeError(f"`hooks` entries must be callables hook(t, q, v, a), got {k!r}.")
+    max_steps = _check_max_steps(stepper, t0, tf, max_steps)
+    q0, v0, state = _initial_state(model, n, q0, v0, state0, events)
+    bound = model.bind(state) if events else model
+    rec = Recorder(bound, monitors)
+    stepper.model = bound
+    stepper.want_quadrature = bool(rec.monitors)
+    state_keys = tuple(state) if events else ()
+
+    wall, cpu = time.perf_counter(), time.process_time()
+    status, message, t_fail = "failed", "", None
+    steps = restarts = events_n = 0
+    t = t0
+    bar = _Progress(progress, t0, tf, getattr(stepper, "name", "run"))
+    try:
+        a0, reason = consistent_acceleration(bound, t0, q0, v0)
+        if a0 is None:
+            raise _Failed(f"initial acceleration at t = {t0:g} failed: {reason}")
+        stepper.initialize(t0, q0, v0, a0, tf)
+        rec.start(t0, q0, v0, a0)
+        j = 0
+        if t_out is None or t_out[0] <= t0:
+            rec.sample(t0, q0, v0, a0, state)
+            j = 1
+        while True:
+            if steps >= max_steps:
+                raise _Failed(f"more than max_steps = {max_steps} steps before t = {tf:g}")
+            out = stepper.step()
+            if not out.ok:
+                raise _Failed(f"step from t = {t:.9g} failed: {out.message}")
+            t_prev, t = t, float(out.t)
+            if not t > t_prev:
+                raise _Failed(f"the step from t = {t_prev:.9g} made no progress (reported t = {t:.9g})")
+            stepper.accept(out)
+            steps += 1
+            rec.advance(t, out.q, out.v, out.a, out.quadrature)
+            tol = GRID_TOL * (t - t_prev)
+            on_grid = False
+            if t_out is None:
+                on_grid = True
+            else:
+                while j < t_out.size and t_out[j] <= t + tol:
+                    if abs(t_out[j] - t) <= tol:
+                        on_grid = True
+                    else:  # inside the step: the stepper's interpolant, before any model event
+                        rec.sample(t_out[j], *stepper.interpolate(float(t_out[j])), state)
+                    j += 1
+            if events:
+                ev = bound.step_event(t, stepper.q, stepper.v)
+                if ev is not None:
+                    q_e, v_e, state = ev
+                    events_n += 1
+                    bound = model.bind(state)
+                    a_e = stepper.a
+                    if getattr(stepper, "consistent_restart", False):
+                        a_e, reason = consistent_acceleration(bound, t, q_e, v_e)
+                        if a_e is None:
+                            raise _Failed(f"acceleration after the model event at t = {t:.9g} failed: {reason}")
+                    stepper.restart(t, np.asarray(q_e, float), np.asarray(v_e, float), a_e, bound)
+                    restarts += 1
+                    rec.rebind(bound)
+            if on_grid:
+                rec.sample(t, stepper.q, stepper.v, stepper.a, state)
+            bar.update(t, steps)
+            reason = rec.stop_reason()
+            if reason:
+                raise _Failed(reason)
+            if t >= tf:
+                status, message = "success", f"reached tf = {tf:g} in {steps} steps"
+                break
+            if any(k(t, stepper.q, stepper.v, stepper.a) is True for k in hooks):
+                status, message = "success", f"stopped by a hook at t = {t:.9g}"
+                break
+    except _Failed as exc:
+        message, t_fail = str(exc), t
+    except Exception as exc:  # noqa: BLE001 - a user's callback must not lose the results
+        message, t_fail = f"run ended at t = {t:.9g} by an exception: {type(exc).__name__}: {exc}", t
+    finally:
+        bar.close()
+    stats = dict(stepper.stats)
+    stats.update(steps=steps, model_events=events_n, restarts=restarts,
+                 wall_time=time.perf_counter() - wall, cpu_time=time.process_time() - cpu)
+    return rec.result(n, state_keys=state_keys, status=status, message=message, stats=stats, t_fail=t_fail,
+                      method=getattr(stepper, "name", type(stepper).__name__), options=stepper.options())
+
+
+class _Failed(Exception):
+    """A run ending as failed (not a bug): the message goes into the Result."""

@@ -1,0 +1,175 @@
+"""Dynamics at equal accuracy: work-precision of ancfdae's integrators against Exudyn's (same process).
+
+``python -m benchmarks.work_precision [--elements 25 100] [--t-end 0.5] [--repeats 3] [--tol 1e-6]``
+
+Problem: Exudyn's flexible pendulum example (flexiblePendulumANCF): L = 1 m, rho A = 10 kg/m,
+EA = 5.25e7 N, EI = 10937.5 N m^2, hinged at x = 0 (position fixed, slope free), gravity 9.81 m/s^2
+in -y, released horizontally from rest; BE2D elements on our side, ObjectANCFCable2D on Exudyn's:
+the same semi-discrete model (same strain measures, same Gauss rules 5/3 points), so one reference
+serves both.
+
+Error: max over the output times (every 10 ms) of the distance of the free end to that of a
+converged reference (ours, Lobatto IIIA-3 at ``--h-ref`` with Newton tolerance 1e-10; its own error
+is estimated against the same method at twice the step and printed). Cost: process (CPU) time of
+the solve call, model built untimed; medians of ``--repeats`` runs with every configuration of both
+codes run once per round (interleaved, so both see the same machine load).
+
+Newton: the same tolerance ``--tol`` on both sides: Exudyn's relative and absolute tolerance
+(modified Newton, its example's settings, adaptive step on as in the example) and ours' relative
+tolerance (max-norm of the residual over that of the step's first residual; modified Newton).
+The definitions differ (Exudyn: 2-norm, reference residual adapted): say so when reading ratios.
+
+Printed: every run (method, step or rtol, CPU s, error, Newton iterations per step, factorisations),
+then at each accuracy level reached by an Exudyn run the cheapest run of each side at least as
+accurate and the ratio ours / Exudyn's best (< 1: ours faster). "Cheapest run at least as
+accurate" is a step function of the sampled step sizes: it favours neither side systematically but
+is coarse; the per-run table is the full picture.
+"""
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+from ancfdae import simulate
+
+from .dynamics import pendulum as build_pendulum
+
+try:
+    from . import _exudyn_peer as peer
+except ImportError:  # pragma: no cover
+    peer = None
+
+#: our configurations: method -> (options, list of step sizes or rtols)
+OURS = {
+    "lobatto3": ({}, [4e-3, 2e-3, 1e-3, 5e-4, 2.5e-4]),
+    "generalized-alpha": ({"rho_inf": 0.8}, [4e-4, 2e-4, 1e-4, 5e-5]),
+    "ida": ({}, [1e-4, 1e-5, 1e-6]),
+}
+#: Exudyn's integrators and their step sizes
+PEER = {"trapezoidal": [4e-4, 2e-4, 1e-4, 5e-5], "generalized_alpha": [4e-4, 2e-4, 1e-4, 5e-5]}
+DT_OUT = 0.01
+
+
+def _tip_history(beam, res):
+    full = np.tile(beam.q_ref, (len(res.t), 1))
+    full[:, beam.free] = res.q
+    return (beam.point_matrix(1.0) @ full.T).T     # (n_t, 2)
+
+
+def run_ours(n, method, x, t_end, tol):
+    """One timed run; x is the step (fixed-step methods) or rtol (IDA)."""
+    opts = dict(OURS[method][0])
+    if method == "ida":
+        opts["rtol"] = x
+    else:
+        opts.update(h=x, newton={"tol": tol})
+    beam = build_pendulum(n)
+    t_eval = np.linspace(0.0, t_end, int(round(t_end / DT_OUT)) + 1)
+    c0 = time.process_time()
+    res = simulate(beam, (0.0, t_end), method, t_eval=t_eval, **opts)
+    cpu = time.process_time() - c0
+    st = res.stats
+    steps = max(int(st.get("steps", 0)), 1)
+    return dict(cpu=cpu, tip=_tip_history(beam, res), t=np.asarray(res.t), ok=res.status == "success",
+                it_per_step=st.get("newton_iterations", 0) / steps, lu=st.get("factorizations", -1),
+                message=res.message)
+
+
+def run_peer(n, integrator, h, t_end, tol):
+    r = peer.pendulum(n, integrator=integrator, t_end=t_end, h=h, repeats=1, output_period=DT_OUT, newton_tol=tol)
+    tip = np.column_stack([r["x"], r["y"]])
+    return dict(cpu=r["cpu"], tip=tip, t=np.asarray(r["t"]), ok=True, it_per_step=r["newton_iterations_per_step"],
+                lu=r["jacobians"], message="")
+
+
+def _error(run, t_ref, tip_ref):
+    tip = np.column_stack([np.interp(t_ref, run["t"], run["tip"][:, k]) for k in range(2)])
+    return float(np.max(np.linalg.norm(tip - tip_ref, axis=1)))
+
+
+def reference(n, t_end, h_ref):
+    """Reference tip history (Lobatto IIIA-3, h_ref, Newton tol 1e-10) and its estimated error."""
+    fine = run_ours(n, "lobatto3", h_ref, t_end, 1e-10)
+    coarse = run_ours(n, "lobatto3", 2 * h_ref, t_end, 1e-10)
+    est = _error(coarse, fine["t"], fine["tip"]) / 15.0   # order 4: e(h) ~ e(2h) / 16
+    return fine["t"], fine["tip"], est
+
+
+def case(n, t_end, repeats, tol, h_ref, methods):
+    t_ref, tip_ref, est = reference(n, t_end, h_ref)
+    print(f"\n== hinged pendulum, {n} BE2D / ObjectANCFCable2D elements, [0, {t_end}] s, Newton tol {tol}; "
+          f"reference Lobatto IIIA-3 h = {h_ref:g} (estimated error {est:.1e} m)", flush=True)
+    configs = [("ours", m, x) for m in methods for x in OURS[m][1]]
+    if peer is not None and peer.available():
+        configs += [("exudyn", m, h) for m, hs in PEER.items() for h in hs]
+    runs = {c: [] for c in configs}
+    failed = set()
+    for _ in range(repeats):
+        for c in configs:
+            if c in failed:
+                continue
+            side, m, x = c
+            try:
+                r = run_ours(n, m, x, t_end, tol) if side == "ours" else run_peer(n, m, x, t_end, tol)
+            except RuntimeError as exc:
+                r = dict(ok=False, message=str(exc))
+            if not r["ok"]:
+                failed.add(c)
+                print(f"  {side} {m} {x:g}: failed ({r['message']})", flush=True)
+                continue
+            runs[c].append(r)
+    rows = []
+    print(f"{'side':<7}{'method':<19}{'h or rtol':>10}{'CPU s':>9}{'error m':>10}{'it/step':>8}{'LU':>7}")
+    for c in configs:
+        if c in failed or not runs[c]:
+            continue
+        rs = runs[c]
+        cpu = float(np.median([r["cpu"] for r in rs]))
+        err = _error(rs[-1], t_ref, tip_ref)
+        rows.append((c, cpu, err))
+        print(f"{c[0]:<7}{c[1]:<19}{c[2]:>10.1e}{cpu:9.3f}{err:10.2e}{rs[-1]['it_per_step']:8.2f}{rs[-1]['lu']:7d}",
+              flush=True)
+    summary(rows)
+    return rows
+
+
+def summary(rows):
+    """At each Exudyn accuracy level: the cheapest run of each side at least as accurate."""
+    ex = [r for r in rows if r[0][0] == "exudyn"]
+    us = [r for r in rows if r[0][0] == "ours"]
+    if not ex:
+        return
+    print("at equal accuracy (each Exudyn error level; cheapest run of each side with error <= it):")
+    for level in sorted({r[2] for r in ex}, reverse=True):
+        e_best = min((r for r in ex if r[2] <= level), key=lambda r: r[1])
+        o = [r for r in us if r[2] <= level]
+        if not o:
+            print(f"  {level:9.2e} m: Exudyn {e_best[0][1]} h={e_best[0][2]:g} {e_best[1]:.3f} s | "
+                  f"no run of ours this accurate")
+            continue
+        o_best = min(o, key=lambda r: r[1])
+        print(f"  {level:9.2e} m: Exudyn {e_best[0][1]} h={e_best[0][2]:g} {e_best[1]:.3f} s | ours "
+              f"{o_best[0][1]} {o_best[0][2]:g} {o_best[1]:.3f} s (error {o_best[2]:.1e}) | ratio "
+              f"{o_best[1] / e_best[1]:.2f}", flush=True)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--elements", type=int, nargs="+", default=[25, 100])
+    ap.add_argument("--t-end", type=float, default=0.5)
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--tol", type=float, default=1e-6, help="Newton tolerance, both sides")
+    ap.add_argument("--h-ref", type=float, default=1e-4)
+    ap.add_argument("--methods", nargs="+", default=list(OURS), choices=list(OURS))
+    a = ap.parse_args(argv)
+    if peer is None or not peer.available():
+        print("exudyn not importable: ancfdae only (pip install '.[benchmark]')")
+    print("CPU = process time; machine possibly shared: read the ratios, not the absolute times")
+    for n in a.elements:
+        case(n, a.t_end, a.repeats, a.tol, a.h_ref, a.methods)
+
+
+if __name__ == "__main__":
+    main()

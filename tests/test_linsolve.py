@@ -1,0 +1,73 @@
+"""Linear solver choice and correctness: banded LAPACK for every small or narrow-banded matrix."""
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from ancfdae.integrators import _linsolve as ls
+from ancfdae.integrators._newton import max_abs
+
+
+def _banded(n, kl, ku, seed=0, dtype=float):
+    rng = np.random.default_rng(seed)
+    A = np.zeros((n, n), dtype=dtype)
+    for d in range(-kl, ku + 1):
+        i = np.arange(max(0, -d), min(n, n - d))
+        A[i, i + d] = rng.standard_normal(i.size) + (1j * rng.standard_normal(i.size) if dtype is complex else 0)
+    return A
+
+
+@pytest.mark.parametrize("n, kl, ku", [(68, 7, 7), (27, 26, 26), (150, 40, 3), (400, 7, 9)])
+def test_band_patterns_use_banded_lu_and_solve_exactly(n, kl, ku):
+    # Catches: the 65-88 DOF gap (SuperLU was chosen there) and a wrong band map (kl/ku swapped).
+    A = _banded(n, kl, ku)
+    lu = ls.factorize(sp.csr_matrix(A))
+    assert isinstance(lu, ls._Banded)
+    b = np.arange(1.0, n + 1)
+    x = lu.solve(b)
+    assert np.abs(A @ x - b).max() <= 1e-10 * np.abs(b).max() * np.linalg.cond(A)
+
+
+def test_complex_banded_system():
+    # Catches: complex data silently cast to real (the Lobatto eigenbasis system is complex).
+    A = _banded(90, 7, 7, dtype=complex)
+    lu = ls.factorize(sp.csr_matrix(A))
+    b = np.linspace(1, 2, 90) + 1j
+    assert np.abs(A @ lu.solve(b) - b).max() < 1e-9
+
+
+def test_wide_large_pattern_goes_to_superlu():
+    A = sp.random(400, 400, density=0.02, random_state=1, format="csr") + sp.eye(400) * 10
+    assert isinstance(ls.factorize(sp.csr_matrix(A)), ls._SuperLU)
+
+
+def test_duplicate_entries_are_summed():
+    # Catches: assignment instead of accumulation into band storage for a non-canonical CSR.
+    data, indices, indptr = np.array([1.0, 2.0, 5.0]), np.array([0, 0, 1]), np.array([0, 2, 3])
+    m = sp.csr_matrix((data, indices, indptr), shape=(2, 2))
+    x = ls.factorize(m).solve(np.array([3.0, 5.0]))
+    assert np.allclose(x, [1.0, 1.0])
+
+
+def test_max_abs_matches_numpy_and_propagates_nan():
+    x = np.array([1.0, -3.0, 2.0])
+    assert max_abs(x) == 3.0 and max_abs(np.zeros(0)) == 0.0
+    assert np.isnan(max_abs(np.array([1.0, np.nan, 5.0]))) and np.isnan(max_abs(np.array([np.nan, 1.0])))
+    assert max_abs(np.array([1.0, -np.inf])) == np.inf
+
+
+def test_compiled_substitution_equals_lapack_dgbtrs():
+    # Catches: pivots read 1-based (scipy returns them 0-based), the wrong band row of L or U.
+    import scipy.linalg.lapack as lapack
+    A = _banded(120, 7, 7, seed=5)
+    lu = ls.factorize(sp.csr_matrix(A))
+    assert lu._compiled
+    b = np.random.default_rng(2).standard_normal(120)
+    x_ref, _ = lapack.dgbtrs(lu.lub, lu.kl, lu.ku, b, lu.piv)
+    assert np.abs(lu.solve(b) - x_ref).max() <= 1e-13 * np.abs(x_ref).max()
+
+
+def test_singular_banded_gives_non_finite_not_an_exception():
+    A = _banded(80, 3, 3)
+    A[:, 10] = 0.0
+    x = ls.factorize(sp.csr_matrix(A)).solve(np.ones(80))
+    assert not np.all(np.isfinite(x))
