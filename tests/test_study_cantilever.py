@@ -4,7 +4,6 @@ import pytest
 
 from ancfdae.cli import main
 from ancfdae.studies import cantilever
-from conftest import check_panel, saved_figures, series, visible_axes
 
 
 def test_quick_study_reproduces_table2_be2d(tmp_path):

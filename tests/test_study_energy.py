@@ -2,15 +2,12 @@
 import pytest
 
 from ancfdae.studies import energy
-from conftest import check_panel, saved_figures, series, visible_axes
 
 
 @pytest.fixture(scope="module")
 def quick(tmp_path_factory):
     out = tmp_path_factory.mktemp("energy")
-    with saved_figures() as figs:
-        res = energy.run(quick=True, out=out, jobs=2, progress=False)
-    return dict(res, figures=figs)
+    return energy.run(quick=True, out=out, jobs=2, progress=False)
 
 
 def test_drift_after_the_load_per_integrator(quick):

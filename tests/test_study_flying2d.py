@@ -9,9 +9,7 @@ from ancfdae.studies._flying import eps_T, output_times, regress_order
 @pytest.fixture(scope="module")
 def quick(tmp_path_factory):
     out = tmp_path_factory.mktemp("flying2d")
-    with saved_figures() as figs:
-        res = flying2d.run(quick=True, out=out, jobs=2, progress=False)
-    return dict(res, figures=figs)
+    return flying2d.run(quick=True, out=out, jobs=2, progress=False)
 
 
 def test_be2d_converges_at_order_4_over_the_whole_span(quick):

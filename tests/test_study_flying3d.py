@@ -3,15 +3,12 @@ import numpy as np
 import pytest
 
 from ancfdae.studies import flying3d
-from conftest import check_panel, saved_figures, series, visible_axes
 
 
 @pytest.fixture(scope="module")
 def quick(tmp_path_factory):
     out = tmp_path_factory.mktemp("flying3d")
-    with saved_figures() as figs:
-        res = flying3d.run(quick=True, out=out, jobs=2, progress=False)
-    return dict(res, figures=figs)
+    return flying3d.run(quick=True, out=out, jobs=2, progress=False)
 
 
 def _rows(quick, element):

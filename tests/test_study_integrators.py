@@ -1,17 +1,13 @@
 """The integrators study in quick mode: a stable work-precision ordering and the observed orders."""
-import numpy as np
 import pytest
 
 from ancfdae.studies import integrators
-from conftest import check_panel, saved_figures, series, visible_axes
 
 
 @pytest.fixture(scope="module")
 def quick(tmp_path_factory):
     out = tmp_path_factory.mktemp("integrators")
-    with saved_figures() as figs:
-        res = integrators.run(quick=True, out=out, jobs=2, progress=False)
-    return dict(res, figures=figs)
+    return integrators.run(quick=True, out=out, jobs=2, progress=False)
 
 
 def _eps(quick, method):
