@@ -9,10 +9,12 @@ from __future__ import annotations
 
 import argparse
 import inspect
+import signal
 import sys
+import threading
 from dataclasses import dataclass
 
-from ._common import Interrupted
+from ._common import Interrupted, OptionError
 
 __all__ = ["Option", "parser", "main"]
 
@@ -58,6 +60,10 @@ def parser(module, prog: str | None = None) -> argparse.ArgumentParser:
     return p
 
 
+def _terminate(signum, frame):
+    raise KeyboardInterrupt
+
+
 def main(module, argv=None, prog: str | None = None) -> int:
     """Parse ``argv``, run the study, print its table; return the exit status (130 after Ctrl-C)."""
     p = parser(module, prog)
@@ -65,6 +71,10 @@ def main(module, argv=None, prog: str | None = None) -> int:
     if args.get("jobs") is not None and args["jobs"] < 1:
         p.error(f"--jobs must be a positive integer, got {args['jobs']}")
     options = {k: v for k, v in args.items() if v is not None and k not in ("quick",)}
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        # `kill PID` (SIGTERM) stops a study like Ctrl-C: finished cases kept, workers stopped, exit 130
+        previous = signal.signal(signal.SIGTERM, _terminate)
     try:
         result = module.run(quick=args["quick"], **options)
     except Interrupted as exc:
@@ -73,8 +83,11 @@ def main(module, argv=None, prog: str | None = None) -> int:
     except KeyboardInterrupt:
         print(f"{p.prog} interrupted.", file=sys.stderr)
         return 130
-    except ValueError as exc:           # bad options (e.g. --out an existing file): said at once
+    except OptionError as exc:          # bad options (e.g. --out an existing file): said at once, before any work
         p.error(str(exc))
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
     if result.get("table"):
         print(result["table"])
     if result.get("path") is not None:

@@ -24,8 +24,12 @@ from pathlib import Path
 
 from ancfdae.result import Result
 
-__all__ = ["Case", "output_dir", "CaseStore", "Sweep", "Interrupted", "run_cases", "markdown_table", "progress_bar",
-           "settings"]
+__all__ = ["Case", "OptionError", "output_dir", "CaseStore", "Sweep", "Interrupted", "run_cases", "markdown_table",
+           "progress_bar", "settings"]
+
+
+class OptionError(ValueError):
+    """A study option is invalid (found before any work; the command line reports it as a usage error)."""
 
 
 def output_dir(name: str, out=None, quick: bool = False) -> Path:
@@ -47,13 +51,13 @@ def output_dir(name: str, out=None, quick: bool = False) -> Path:
     """
     path = Path(out) if out is not None else Path("out") / (f"{name}-quick" if quick else name)
     if path.exists() and not path.is_dir():
-        raise ValueError(f"`out` must be a folder, got {str(path)!r}, which is an existing file.")
+        raise OptionError(f"`out` must be a folder, got {str(path)!r}, which is an existing file.")
     try:
         path.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise ValueError(f"`out` must be a folder that can be created, got {str(path)!r}: {exc}") from None
+        raise OptionError(f"`out` must be a folder that can be created, got {str(path)!r}: {exc}") from None
     if not os.access(path, os.W_OK):
-        raise ValueError(f"`out` must be a writable folder, got {str(path)!r}.")
+        raise OptionError(f"`out` must be a writable folder, got {str(path)!r}.")
     return path
 
 

@@ -22,7 +22,7 @@ from ancfdae import models
 from ancfdae.result import Result
 
 from ._cli import Option
-from ._common import Case, markdown_table, output_dir, run_cases, settings
+from ._common import Case, OptionError, markdown_table, output_dir, run_cases, settings
 
 __all__ = ["run", "run_case", "build", "solve_case", "ELEMENTS", "TABLE2", "REFERENCE", "FULL", "QUICK",
            "CLI_OPTIONS"]
@@ -210,7 +210,7 @@ def run(elements=None, n_elements=None, repeats=None, quick: bool = False, out=N
     names = list(o["elements"]) if o["elements"] else available_elements()
     for name in names:
         if name not in available_elements():
-            raise ValueError(f"`elements` must name types of {available_elements()}, got {name!r}.")
+            raise OptionError(f"`elements` must name types of {available_elements()}, got {name!r}.")
     path = output_dir("cantilever", out, quick) if (plots or out is not None) else None
     cases = [Case(element=name, n=n, repeats=o["repeats"], label=f"{name} {n} el")
              for name in names for n in o["n_elements"]]

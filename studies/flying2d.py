@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._cli import Option
-from ._common import markdown_table, output_dir, run_cases, settings
+from ._common import OptionError, markdown_table, output_dir, run_cases, settings
 from ._flying import FAMILY, Case, T_PULSE, available, b2_beam, eps_T, regress_order, simulate_case, steady_drift, \
     unpack
 
@@ -111,7 +111,7 @@ def run(elements=None, n_elements=None, n_ref=None, n_elements_3d=None, t_end=No
                                           n_elements_3d=n_elements_3d, t_end=t_end, h=h, dt_out=dt_out))
     names = available(o["elements"])
     if len(names) != len(list(o["elements"])) or not names:
-        raise ValueError(f"`elements` must name types of {available(ELEMENTS)}, got {list(o['elements'])}.")
+        raise OptionError(f"`elements` must name types of {available(ELEMENTS)}, got {list(o['elements'])}.")
     path = output_dir("flying2d", out, quick) if (plots or out is not None) else None
     twins = sorted({_TWIN[n] for n in names})
     cases = [{"element": name, "n": o["n_ref"], "reference": True} for name in twins]

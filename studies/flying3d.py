@@ -34,7 +34,7 @@ import numpy as np
 from ancfdae.simulate import METHODS
 
 from ._cli import Option
-from ._common import Case, markdown_table, output_dir, run_cases, settings
+from ._common import Case, OptionError, markdown_table, output_dir, run_cases, settings
 from ._flying import T_HAT, available, b3_beam, simulate_case, steady_drift, unpack
 
 __all__ = ["run", "run_case", "summarize", "UpdateAudit", "FULL", "QUICK", "CLI_OPTIONS", "CHAPTER_FAILURES"]
@@ -235,11 +235,11 @@ def run(be_meshes=None, sq_meshes=None, variants=None, variant_mesh=None, method
                                           t_end_sq=t_end_sq, h=h, dt_out=dt_out))
     unknown = [m for m in o["methods"] if m not in METHODS]
     if unknown:
-        raise ValueError(f"`methods` must be keys of {sorted(METHODS)}, got {unknown}.")
+        raise OptionError(f"`methods` must be keys of {sorted(METHODS)}, got {unknown}.")
     missing = [n for n in ("BE3D", "SQ3D") if n not in available(("BE3D", "SQ3D"))]
     cases = _cases(o)
     if not cases:
-        raise ValueError("flying3d has no case to run: no BE3D/SQ3D meshes, or neither type in ancfdae.models.")
+        raise OptionError("flying3d has no case to run: no BE3D/SQ3D meshes, or neither type in ancfdae.models.")
     path = output_dir("flying3d", out, quick) if (plots or out is not None) else None
     sweep = run_cases(run_case, cases, out=path, executor=executor, jobs=jobs, reduce=_unpack, name="flying3d",
                       progress=progress, cost=_cost)

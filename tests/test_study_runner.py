@@ -78,8 +78,9 @@ def test_cli_help_states_the_defaults(capsys):
     assert "number of cases (default: 4; with --quick: 2)" in text and "out/toy-quick" in text
 
 
-def _interrupt(tmp_path, jobs):
-    """Start the toy study in its own session, Ctrl-C (SIGINT to the group) once 2 cases are stored."""
+def _interrupt(tmp_path, jobs, how="ctrl-c"):
+    """Start the toy study in its own session; once 2 cases are stored, Ctrl-C (SIGINT to the process group,
+    as a terminal sends it) or ``kill PID`` (SIGTERM to the main process only)."""
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(HERE), str(ROOT)]), TOY_SLOW_FROM="2")
     args = [sys.executable, "-c", _MAIN, "--out", str(tmp_path), "--sleep", "0.1"]
     if jobs:
@@ -92,7 +93,10 @@ def _interrupt(tmp_path, jobs):
         time.sleep(0.1)
     time.sleep(0.5)                                   # the slow cases are running now
     t0 = time.monotonic()
-    os.killpg(proc.pid, signal.SIGINT)
+    if how == "ctrl-c":
+        os.killpg(proc.pid, signal.SIGINT)
+    else:
+        os.kill(proc.pid, signal.SIGTERM)
     out, err = proc.communicate(timeout=30)
     return proc.returncode, time.monotonic() - t0, err
 
@@ -105,9 +109,9 @@ def _alive(pid):
     return "zombie" not in status
 
 
-@pytest.mark.parametrize("jobs", [None, 2])
-def test_ctrl_c_stops_within_seconds_keeps_finished_cases_and_exits_130(tmp_path, jobs):
-    code, seconds, err = _interrupt(tmp_path, jobs)
+@pytest.mark.parametrize("jobs, how", [(None, "ctrl-c"), (2, "ctrl-c"), (2, "kill")])
+def test_ctrl_c_stops_within_seconds_keeps_finished_cases_and_exits_130(tmp_path, jobs, how):
+    code, seconds, err = _interrupt(tmp_path, jobs, how)
     assert code == 130 and seconds < 10.0, (code, seconds, err)
     assert "Traceback" not in err
     last = [line for line in err.replace("\r", "\n").splitlines() if line.strip()][-1]

@@ -59,6 +59,11 @@ class IDA(Integrator):
         run time. The velocity tolerance decides the cost on stiff beams: on the 25-element
         BE2D pendulum (0.2 s, rtol 1e-6) the default resolved the axial vibrations (8,903
         steps, tip error 8e-7) while ``atol=(1e-6, 1e-2)`` took 217 steps (tip error 1.5e-4).
+        On B2 (8 BE2D elements, [0, 4] s) the cost stays near 3,500 steps from rtol 1e-4 to
+        1e-6 because the default resolves the axial vibrations; a looser velocity tolerance
+        did not reach a given eps_T any cheaper (rtol 1e-4, ``atol=(rtol, 10 rtol)``: 333 steps
+        but eps_T 6.9e-4 against 4.3e-6; rtol 1e-6, ``(rtol, 100 rtol)``: 4.7e-6 against 4.2e-8
+        at the same step count).
     max_order : int in [1, 5]
         BDF order limit (default 5, see Notes).
     max_step, first_step : float, optional
@@ -81,9 +86,11 @@ class IDA(Integrator):
     order <= 3: 1.2e-4 / 6.3e-6 / 4.6e-7 (9,500 steps, 1.6-2.0 s); order <= 2: 3.9e-4 /
     5.7e-5 / 5.4e-6 (0.5-1.3 s), and 2.8e-8 only at rtol 1e-9 after 77,559 steps and 10.5 s.
     CPU to reach eps_T = 1e-6: 0.9 s (order 5), 1.4 s (4), 2.0 s (3), 1.9 s (2); Lobatto IIIA-3
-    0.7 s. The integrator study's problems (4 elements, [0, 2] s): B2, order 5 was 30-75x more
-    accurate at equal or lower CPU for rtol 1e-5..1e-7; B2 with E x 100, orders 3-5 are held by
-    stability, not accuracy (about 8,000 steps whatever rtol, eps_T 6.5e-8 at rtol 1e-6), where
+    0.7 s; measured again with medians of 3 interleaved runs: IDA default 0.65 s, Lobatto
+    0.57 s (at eps_T 4e-8 IDA took 0.66 s, Lobatto 0.95 s for 6.8e-8). The integrator study's
+    problems (4 elements, [0, 2] s): B2, order 5 was 30-75x more accurate at equal or lower
+    CPU for rtol 1e-5..1e-7; B2 with E x 100, orders 3-5 are held by stability, not accuracy
+    (about 8,000 steps whatever rtol, eps_T 6.5e-8 at rtol 1e-6), where
     order 2 reached 7e-7 in 1,865 steps (rtol 1e-7): for stiff undamped beams at moderate
     accuracy ``max_order=2`` can be cheaper. (The order-2 cap of earlier versions came from a
     linear chain, where BDF 3-5, not A-stable, forced tiny steps.)
@@ -98,7 +105,9 @@ class IDA(Integrator):
     first step). Updating after every step is unusable with IDA: on B3 (2 elements, rtol 1e-6)
     20,000 steps and 20,000 restarts reached only t = 0.055 s in 100 s CPU, while with
     ``BE3D(update_below=0.5)`` 0.2 s took 41 steps, no restart, 0.09 s CPU. Use
-    ``update_below`` with IDA.
+    ``update_below`` with IDA. A run that starts at rest under a load that starts from zero
+    has a stationary initial state: IDA's first step then scales with the span (a run over
+    [0, 1e6] s stepped over a 3 s load); give ``max_step`` for long spans.
 
     Statistics: ``newton_iterations`` counts calls of the residual, which SUNDIALS' Newton
     solver evaluates exactly once per iteration (the Jacobian is ours, no difference

@@ -17,6 +17,8 @@ class BeamEvents:
         caps = {"residual_jacobian", "residual_stages"}
         if not self.mass_is_constant:
             caps.add("variable_mass")
+        else:
+            caps.add("potential")       # M a + dP/dq - f_nc with a constant M (PotentialMixin)
         if self.element.event_state(self.geom):
             caps.add("step_events")
         return frozenset(caps)

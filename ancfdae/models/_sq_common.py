@@ -65,6 +65,12 @@ class SQElement(KernelOption, Element):
         return (f"{self.name}(formulation={self.formulation!r}, nodes={self.nodes}, "
                 f"quadrature={self.quadrature!r}, kernel={self._kernel!r})")
 
+    @property
+    def energy_degree(self):
+        """4 for the continuum formulations (St. Venant-Kirchhoff energy of the Green strain, which is
+        quadratic in q, Eqs. 13, 28-33); None for the structural one (|r'| and the frame of Eq. 7)."""
+        return None if self.formulation == "structural" else 4
+
     # -- options ----------------------------------------------------------------------------
     def default_quadrature(self) -> dict:
         """Default rules, ``term -> (kind, n_points)``.

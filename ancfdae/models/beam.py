@@ -24,6 +24,7 @@ from ._beam_loads import BeamLoads
 from ._beam_stages import BeamStages
 from ._element import Element
 from ._mesh import mesh_from_points, straight_mesh
+from ._potential import PotentialMixin
 
 __all__ = ["Beam"]
 
@@ -35,7 +36,7 @@ def _finish_residual():
     return finish_residual
 
 
-class Beam(BeamChecks, BeamLoads, BeamStages, BeamEvents):
+class Beam(PotentialMixin, BeamChecks, BeamLoads, BeamStages, BeamEvents):
     """A beam of ANCF elements with supports and loads: a Model.
 
     Parameters
@@ -78,6 +79,11 @@ class Beam(BeamChecks, BeamLoads, BeamStages, BeamEvents):
         Free coordinates.
     load_factor : float
         Multiplies every external load (the static solver steps it).
+
+    Notes
+    -----
+    Also a :class:`ancfdae.problem.PotentialModel` (methods of
+    :class:`~ancfdae.models._potential.PotentialMixin`).
     """
 
     def __init__(self, element: Element, n_elements=None, length=None, start=None, direction=None, *,
