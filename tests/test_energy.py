@@ -19,7 +19,7 @@ T_EVAL = np.linspace(0.0, T_END, 71)
 
 
 def b2_beam(n_elements=4):
-    """The B2 beam (revision 2): L = 1, a = 0.05, E = 1e5, nu = 0.3, rho = 2500, r(s) = s (0.6, 0.8), 0.24 N, 0.24 N m."""
+    """The B2 beam (revision 2): L = 1, a = 0.05, E = 1e5, nu = 0.3, rho = 2500, r(s) = s (0.6, 0.8); 0.24 N, N m."""
     el = BE2D(Material(E=1e5, nu=0.3, rho=2500.0), RectangularSection(0.05))
     return Beam(el, n_elements=n_elements, length=1.0, direction=(0.6, 0.8),
                 loads=[PointForce((0.24, 0.0), node=0, time=pulse(T_LOAD)),
@@ -73,8 +73,10 @@ def test_b2_generalized_alpha_dissipates():
 
 
 def test_b2_ida_drift_shrinks_with_rtol():
-    d = [free_drift(b2_run("ida", r)) for r in (1e-4, 1e-5)]
-    assert d[1] < 0.5 * d[0], d
+    """IDA's energy drift follows its tolerance (B2 revision 2, default max order 5, measured: 5.4e-6 J at
+    rtol 1e-3, 5.3e-8 J at 1e-6; not monotone between 1e-4 and 1e-5, 3.3e-7 and 5.0e-7 J)."""
+    d = [free_drift(b2_run("ida", r)) for r in (1e-3, 1e-6)]
+    assert d[1] < 0.1 * d[0], d
 
 
 def test_b2_integrators_agree_on_tip_trajectory():
