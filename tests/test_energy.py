@@ -19,7 +19,7 @@ T_EVAL = np.linspace(0.0, T_END, 71)
 
 
 def b2_beam(n_elements=4):
-    """The B2 beam (revision 2): L = 1, a = 0.05, E = 1e5, nu = 0.3, rho = 2500, r(s) = s (0.6, 0.8), 0.24 N, 0.24 N m."""
+    """The B2 beam (revision 2): L = 1, a = 0.05, E = 1e5, nu = 0.3, rho = 2500, r(s) = s (0.6, 0.8); 0.24 N, N m."""
     el = BE2D(Material(E=1e5, nu=0.3, rho=2500.0), RectangularSection(0.05))
     return Beam(el, n_elements=n_elements, length=1.0, direction=(0.6, 0.8),
                 loads=[PointForce((0.24, 0.0), node=0, time=pulse(T_LOAD)),

@@ -18,6 +18,9 @@ from ancfdae.studies._common import Case, output_dir, run_cases
 HERE = Path(__file__).parent
 ROOT = HERE.parent
 _MAIN = "import sys, study_toy; from ancfdae.studies import _cli; sys.exit(_cli.main(study_toy, sys.argv[1:]))"
+# A terminal's Ctrl-C: the child gets Python's SIGINT handler even when the test session itself runs in the
+# background (where the shell made SIGINT ignored, and children inherit that)
+_CTRL_C = "import signal; signal.signal(signal.SIGINT, signal.default_int_handler); " + _MAIN
 
 
 def test_each_case_is_stored_and_a_rerun_reuses_it(tmp_path):
@@ -82,7 +85,7 @@ def _interrupt(tmp_path, jobs, how="ctrl-c"):
     """Start the toy study in its own session; once 2 cases are stored, Ctrl-C (SIGINT to the process group,
     as a terminal sends it) or ``kill PID`` (SIGTERM to the main process only)."""
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(HERE), str(ROOT)]), TOY_SLOW_FROM="2")
-    args = [sys.executable, "-c", _MAIN, "--out", str(tmp_path), "--sleep", "0.1"]
+    args = [sys.executable, "-c", _CTRL_C, "--out", str(tmp_path), "--sleep", "0.1"]
     if jobs:
         args += ["--jobs", str(jobs)]
     proc = subprocess.Popen(args, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
