@@ -11,14 +11,15 @@ CSR data through a precomputed map into band storage.
 Storage: ``ab`` of shape ``(n, 2 kl + ku + 1)`` in C order, i.e. LAPACK's
 Fortran ``AB(ldab, n)`` with ``A[i, j]`` at ``ab[j, kl + ku + i - j]``; the
 first ``kl`` rows of AB (the fill-in of U) start as zero. The pivots ``piv``
-are 0-based row indices.
+are 0-based row indices. The transpose ``ab.T`` is LAPACK's factor itself, so the solve is the
+package's :func:`ancfdae.integrators._linsolve_numba.band_solve` applied to ``ab.T``.
 """
 from __future__ import annotations
 
 import numpy as np
 from numba import njit
 
-__all__ = ["band_fill", "band_factor", "band_solve"]
+__all__ = ["band_fill", "band_factor"]
 
 
 @njit(cache=True)
@@ -79,27 +80,3 @@ def band_factor(ab, kl, ku, piv):
                         row[a + i] -= col[i] * u
     return info
 
-
-@njit(cache=True)
-def band_solve(ab, kl, ku, piv, b):
-    """Solve ``A x = b`` in place in ``b`` with the factors of :func:`band_factor`."""
-    n = ab.shape[0]
-    kv = kl + ku
-    if kl > 0:
-        for j in range(n - 1):
-            lm = min(kl, n - 1 - j)
-            p = piv[j]
-            if p != j:
-                tmp = b[p]
-                b[p] = b[j]
-                b[j] = tmp
-            bj = b[j]
-            if bj != 0.0:
-                for i in range(1, lm + 1):
-                    b[j + i] -= ab[j, kv + i] * bj
-    for j in range(n - 1, -1, -1):
-        b[j] /= ab[j, kv]
-        bj = b[j]
-        if bj != 0.0:
-            for i in range(max(0, j - kv), j):
-                b[i] -= ab[j, kv + i - j] * bj

@@ -114,14 +114,7 @@ def _build_b1_beam3d(n):
     J = I2 + I3 and k_t = 0.8436 (benchmarks.md); the cross-section penalty factors are Exudyn's
     defaults (1, 1, 1).
     """
-    a, E, nu, rho = B1["a"], B1["E"], B1["nu"], B1["rho"]
-    G = E / (2 * (1 + nu))
-    ks = 10 * (1 + nu) / (12 + 11 * nu)
-    A, I = a**2, a**4 / 12
-    sec = _exu.BeamSection()
-    sec.stiffnessMatrix = np.diag([E * A, ks * G * A, ks * G * A, _K_TORSION * G * 2 * I, E * I, E * I])
-    sec.massPerLength = rho * A
-    sec.inertia = rho * np.diag([2 * I, I, I])  # statics only; kept physical
+    sec = _section_b1()
     SC = _exu.SystemContainer()
     mbs = SC.AddSystem()
     ground = _ground_marker(mbs)

@@ -5,7 +5,7 @@ import pytest
 from ancfdae import EnergyMonitor, PointSensor, Probe, simulate
 from ancfdae.integrators._hermite import hermite5
 from ancfdae.integrators import IDA, GeneralizedAlpha, LobattoIIIA, Newmark, NewtonOptions
-from toy_models import DoublePendulum, SpringChain
+from toy_models import DoublePendulum, NaNAfter, SpringChain
 
 # (method, options): every integrator of the registry, with the step it needs
 CASES = [
@@ -110,24 +110,9 @@ def test_last_step_shortened_to_reach_tf():
     assert res.success and abs(res.t[-1] - 0.105) < 1e-15 and res.stats["steps"] == 11
 
 
-class _NaNAfter:
-    """Wraps a model; its residual turns NaN after t_bad (a step that cannot converge)."""
-
-    def __init__(self, model, t_bad):
-        self.m, self.t_bad = model, t_bad
-        self.n_dof, self.mass_is_constant = model.n_dof, model.mass_is_constant
-
-    def __getattr__(self, name):
-        return getattr(self.m, name)
-
-    def residual(self, t, q, v, a):
-        r = self.m.residual(t, q, v, a)
-        return r * np.nan if t > self.t_bad else r
-
-
 @pytest.mark.parametrize("method, opts", CASES, ids=IDS)
 def test_failure_returns_partial_result(method, opts):
-    res = simulate(_NaNAfter(SpringChain(2), 0.3), (0.0, 1.0), method, t_eval=np.linspace(0, 1, 21), **opts)
+    res = simulate(NaNAfter(SpringChain(2), 0.3), (0.0, 1.0), method, t_eval=np.linspace(0, 1, 21), **opts)
     assert not res.success and res.status == "failed"
     assert res.t_fail is not None and 0.2 <= res.t_fail <= 0.3 + 1e-12
     assert f"{res.t_fail:.4g}"[:3] in res.message or "t = 0.2" in res.message or "0.29" in res.message

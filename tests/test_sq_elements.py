@@ -4,7 +4,7 @@ import pytest
 
 from ancfdae import CircularSection, RectangularSection
 from ancfdae.models import SQ2D, SQ3D, Beam
-from conftest import fd_gradient, rel_err
+from conftest import assert_forces_and_tangent_fd, fd_gradient, rel_err
 
 FORMULATIONS = ["structural", "continuum", "continuum-locking"]
 
@@ -32,20 +32,7 @@ def test_forces_are_energy_gradient_and_tangent_is_exact(steel, cls, formulation
     el = cls(steel, section, formulation, nodes=nodes)
     beam = Beam(el, 2, 1.3, direction=np.ones(el.dim))          # oblique, to exercise the frames
     q = deformed(beam, 0.05, 1)
-    f, K = el.internal_forces(beam.geom, q)
-    for e in range(2):
-        def energy(x, e=e):
-            qq = q.copy()
-            qq[e] = x
-            return el.strain_energy(beam.geom, qq)[e]
-
-        def force(x, e=e):
-            qq = q.copy()
-            qq[e] = x
-            return el.internal_forces(beam.geom, qq, False)[0][e]
-        assert rel_err(f[e], fd_gradient(energy, q[e])) < 1e-7
-        assert rel_err(K[e], fd_gradient(force, q[e])) < 1e-7
-    assert np.abs(K - np.swapaxes(K, 1, 2)).max() < 1e-12 * np.abs(K).max()
+    assert_forces_and_tangent_fd(el, beam.geom, q)
 
 
 @pytest.mark.parametrize("cls", [SQ2D, SQ3D])

@@ -8,7 +8,7 @@ import pytest
 
 from ancfdae import RectangularSection
 from ancfdae.models import SQ2D, SQ3D, Beam
-from conftest import fd_gradient, rel_err
+from conftest import assert_forces_and_tangent_fd, rel_err
 
 pytest.importorskip("numba")
 
@@ -68,20 +68,7 @@ def test_numba_forces_are_energy_gradient_and_tangent_is_exact(steel, cls, formu
     el, beam, qs = _beam_and_states(steel, cls, formulation, 3, n_states=2)
     el.kernel = "numba"
     q = qs[1]
-    f, K = el.internal_forces(beam.geom, q)
-    for e in range(len(q)):
-        def energy(x, e=e):
-            qq = q.copy()
-            qq[e] = x
-            return el.strain_energy(beam.geom, qq)[e]
-
-        def force(x, e=e):
-            qq = q.copy()
-            qq[e] = x
-            return el.internal_forces(beam.geom, qq, False)[0][e]
-        assert rel_err(f[e], fd_gradient(energy, q[e])) < 1e-7
-        assert rel_err(K[e], fd_gradient(force, q[e])) < 1e-7
-    assert np.abs(K - np.swapaxes(K, 1, 2)).max() < 1e-12 * np.abs(K).max()
+    assert_forces_and_tangent_fd(el, beam.geom, q)
 
 
 def test_kernel_option(steel):

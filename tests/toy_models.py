@@ -233,3 +233,19 @@ class DoublePendulum:
     def step_event(self, t, q, v):
         self.accepted.append(t)
         return None
+
+
+class NaNAfter:
+    """Wraps a model (forwarding everything, declaring nothing); its residual turns NaN after t_bad (a step
+    that cannot converge)."""
+
+    def __init__(self, model, t_bad):
+        self.m, self.t_bad = model, t_bad
+        self.n_dof, self.mass_is_constant = model.n_dof, model.mass_is_constant
+
+    def __getattr__(self, name):
+        return getattr(self.m, name)
+
+    def residual(self, t, q, v, a):
+        r = self.m.residual(t, q, v, a)
+        return r * np.nan if t > self.t_bad else r

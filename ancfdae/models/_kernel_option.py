@@ -5,7 +5,7 @@ import importlib.util
 
 from .._validate import choice
 
-__all__ = ["KERNELS", "numba_available", "resolve_kernel"]
+__all__ = ["KERNELS", "KernelOption", "numba_available", "resolve_kernel"]
 
 KERNELS = ("auto", "numpy", "numba")
 
@@ -28,3 +28,23 @@ def resolve_kernel(kernel: str) -> str:
         raise ImportError("`kernel` 'numba' needs numba (a dependency of ancfdae), which is not importable; "
                           "reinstall ancfdae or use kernel='auto' or 'numpy'.")
     return kernel
+
+
+class KernelOption:
+    """The ``kernel`` attribute of an element (a mixin): setting it checks the option and resolves the
+    implementation once, so the kernels read ``self._impl`` ("numpy" or "numba")."""
+
+    @property
+    def kernel(self) -> str:
+        """The ``kernel`` option as given ("auto", "numpy" or "numba")."""
+        return self._kernel
+
+    @kernel.setter
+    def kernel(self, value):
+        self._impl = resolve_kernel(value)
+        self._kernel = value
+
+    @property
+    def kernel_in_use(self) -> str:
+        """The implementation that runs: "numpy" or "numba"."""
+        return self._impl

@@ -14,7 +14,7 @@ from .._validate import choice
 from ..materials import CircularSection, Material, RectangularSection
 from ._element import Element
 from ._quadrature import gauss
-from ._kernel_option import resolve_kernel
+from ._kernel_option import KernelOption
 from ._sq_kernels import assemble, continuum_kernel, local_map, rule, shapes, structural_kernel, voigt
 
 __all__ = ["SQElement", "shear_factors"]
@@ -31,7 +31,7 @@ def shear_factors(section, material) -> tuple[float, float]:
     return k, k
 
 
-class SQElement(Element):
+class SQElement(KernelOption, Element):
     """Shared implementation; see :class:`~ancfdae.models.SQ2D` and :class:`~ancfdae.models.SQ3D`."""
 
     formulations = ("structural", "continuum", "continuum-locking")
@@ -60,21 +60,6 @@ class SQElement(Element):
         self.node_params = (-1.0, 1.0, 0.0) if nodes == 3 else (-1.0, 1.0)
         self.quadrature = self._parse_quadrature(quadrature)
         self.kernel = kernel
-
-    @property
-    def kernel(self) -> str:
-        """The ``kernel`` option as given ("auto", "numpy" or "numba")."""
-        return self._kernel
-
-    @kernel.setter
-    def kernel(self, value):
-        self._impl = resolve_kernel(value)
-        self._kernel = value
-
-    @property
-    def kernel_in_use(self) -> str:
-        """The implementation that runs: "numpy" or "numba"."""
-        return self._impl
 
     def __repr__(self):
         return (f"{self.name}(formulation={self.formulation!r}, nodes={self.nodes}, "

@@ -19,7 +19,7 @@ import numpy as np
 from .._validate import choice, positive_int
 from ..materials import Material
 from ._element import Element
-from ._kernel_option import resolve_kernel
+from ._kernel_option import KernelOption
 from ._quadrature import gauss
 from ._shapes import hermite
 
@@ -37,7 +37,7 @@ def _expand2(N: np.ndarray) -> np.ndarray:
     return out
 
 
-class BE2D(Element):
+class BE2D(KernelOption, Element):
     """Planar Bernoulli-Euler ANCF beam element (chapter Sects. 3.1-3.3).
 
     Parameters
@@ -88,21 +88,6 @@ class BE2D(Element):
         self.axial_points = positive_int("axial_points", axial_points)
         self.bending_points = positive_int("bending_points", bending_points)
         self.kernel = kernel
-
-    @property
-    def kernel(self) -> str:
-        """The ``kernel`` option as given ("auto", "numpy" or "numba")."""
-        return self._kernel
-
-    @kernel.setter
-    def kernel(self, value):
-        self._impl = resolve_kernel(value)
-        self._kernel = value
-
-    @property
-    def kernel_in_use(self) -> str:
-        """The implementation that runs: "numpy" or "numba"."""
-        return self._impl
 
     def __repr__(self):
         return (f"BE2D(formulation={self.formulation!r}, axial_points={self.axial_points}, "

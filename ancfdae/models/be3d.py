@@ -11,10 +11,11 @@ from __future__ import annotations
 import numpy as np
 
 from .._validate import choice, finite_vector, positive_int
-from ._be3d_dynamics import UPDATES, director_sines, rotary_inertia, rotary_kinetic_energy, update_directors
+from ._be3d_dynamics import UPDATES, rotary_inertia, rotary_kinetic_energy
+from ._be3d_events import BE3DEvents
 from ._be3d_kinematics import curvature_energy, curvatures, director_field, frames, spin_gradient
 from ._element import Element
-from ._kernel_option import resolve_kernel
+from ._kernel_option import KernelOption
 from ._scalar_jet import Jet
 from ._shapes import hermite, linear
 from ._thin import (PointRule, assemble, axial_energy, check_material_section, clamp_coordinates,
@@ -30,7 +31,7 @@ _NDOF = 14
 _PARALLEL_TOL = 1e-6
 
 
-class BE3D(Element):
+class BE3D(KernelOption, BE3DEvents, Element):
     """Spatial thin ANCF beam with torsional stiffness (chapter Sects. 3.5-3.6).
 
     Frame (Eqs. 96-100): ``e1 = r'/|r'|``; ``e30`` the normalised projection
@@ -134,21 +135,6 @@ class BE3D(Element):
         self.rhoJ = material.rho * section.J
         self._pending = None
         self.kernel = kernel
-
-    @property
-    def kernel(self) -> str:
-        """The ``kernel`` option as given ("auto", "numpy" or "numba")."""
-        return self._kernel
-
-    @kernel.setter
-    def kernel(self, value):
-        self._impl = resolve_kernel(value)
-        self._kernel = value
-
-    @property
-    def kernel_in_use(self) -> str:
-        """The implementation that runs: "numpy" or "numba"."""
-        return self._impl
 
     def __repr__(self):
         return (f"BE3D(director_update={self.director_update!r}, axial_points={self.axial_points}, "
@@ -384,32 +370,6 @@ class BE3D(Element):
                                        _DOF, _THETA, rule.dN, rule.wdx, rule.lin, self._directors(geom),
                                        self.rhoJ)
         return rotary_kinetic_energy(geom["inertia"], geom, q, v, self.rhoJ)
-
-    def event_state(self, geom) -> dict:
-        """``{"directors": (n_nodes, 3)}``: the nodal directors, carried by the driver between steps."""
-        return {"directors": geom["directors"]}
-
-    def bind(self, geom, state) -> dict:
-        """``geom`` with the nodal directors of ``state`` (read-only; ``geom`` itself is unchanged)."""
-        D = np.array(state["directors"], dtype=float)
-        if D.shape != geom["directors"].shape:
-            raise ValueError(f"`state['directors']` must have shape {geom['directors'].shape}, got {D.shape}.")
-        D.setflags(write=False)
-        return dict(geom, directors=D)
-
-    def step_event(self, geom, Q, V):
-        """Director update of Sect. 3.6 (``director_update``, ``update_below``); None when not done.
-
-        See :func:`._be3d_dynamics.update_directors`.
-        """
-        if self.director_update == "none":
-            return None
-        D = geom["directors"]
-        Q = np.asarray(Q, dtype=float)
-        if self.update_below is not None and np.min(director_sines(D, Q)) >= self.update_below:
-            return None
-        Q2, V2, D2 = update_directors(D, Q, np.asarray(V, dtype=float), self.director_update)
-        return Q2, V2, {"directors": D2}
 
 
 def _check_director(d, e1):

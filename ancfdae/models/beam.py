@@ -8,23 +8,23 @@ its iteration matrix by combining data arrays.
 """
 from __future__ import annotations
 
-import copy
 import functools
-import numbers
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable
 
 import numpy as np
 import scipy.sparse as sp
 
-from .._validate import check_shape
 from ..loads import DistributedLoad, Gravity, PointForce, PointMoment
 from ..problem import Energy, JacobianBlocks
 from . import _describe
 from ._assembly import Assembler
+from ._beam_checks import BeamChecks
+from ._beam_events import BeamEvents
+from ._beam_loads import BeamLoads
+from ._beam_stages import BeamStages
 from ._element import Element
 from ._mesh import mesh_from_points, straight_mesh
 from ._potential import PotentialMixin
-from ._quadrature import gauss
 
 __all__ = ["Beam"]
 
@@ -36,14 +36,7 @@ def _finish_residual():
     return finish_residual
 
 
-@functools.cache
-def _finish_stages():
-    """The compiled stage version of :func:`_finish_residual`."""
-    from ._assembly_numba import finish_stages
-    return finish_stages
-
-
-class Beam(PotentialMixin):
+class Beam(PotentialMixin, BeamChecks, BeamLoads, BeamStages, BeamEvents):
     """A beam of ANCF elements with supports and loads: a Model.
 
     Parameters
@@ -84,13 +77,13 @@ class Beam(PotentialMixin):
     ----------
     n_dof : int
         Free coordinates.
+    load_factor : float
+        Multiplies every external load (the static solver steps it).
 
     Notes
     -----
     Also a :class:`ancfdae.problem.PotentialModel` (methods of
     :class:`~ancfdae.models._potential.PotentialMixin`).
-    load_factor : float
-        Multiplies every external load (the static solver steps it).
     """
 
     def __init__(self, element: Element, n_elements=None, length=None, start=None, direction=None, *,
@@ -132,27 +125,7 @@ class Beam(PotentialMixin):
         self.geom = element.prepare(self.q_ref[self.edofs], lengths)
 
         # Supports: eliminate fixed coordinates.
-        fixed = np.zeros(self.q_ref.size, dtype=bool)
-        if supports is not None and not isinstance(supports, Mapping):
-            raise TypeError(f"`supports` must be a dict {{node: kind}} with kind 'clamp', 'pin' or a tuple of "
-                            f"coordinate names, e.g. {{0: 'clamp'}}; got {supports!r}.")
-        for node, kind in (supports or {}).items():
-            i = self._node_index(node, "supports")
-            if not isinstance(kind, (str, tuple, list)):
-                raise ValueError(f"`supports` kind must be 'clamp', 'pin' or a tuple of coordinate names "
-                                 f"{element.node_coordinates}, got {kind!r} at node {node}.")
-            if isinstance(kind, str):
-                if kind not in ("clamp", "pin"):
-                    raise ValueError(f"`supports` kind must be 'clamp', 'pin' or a tuple of coordinate names "
-                                     f"{element.node_coordinates}, got {kind!r} at node {node}.")
-                names = element.support_coordinates(kind, frames[i])
-            else:
-                names = tuple(kind)
-            for name in names:
-                if name not in element.node_coordinates:
-                    raise ValueError(f"`supports` coordinate must be one of {element.node_coordinates}, "
-                                     f"got {name!r} at node {node}.")
-                fixed[i * nnd + element.node_coordinates.index(name)] = True
+        fixed = self._fixed_coordinates(supports)
         self.fixed = fixed
         self.free = np.flatnonzero(~fixed)
         self.n_dof = int(self.free.size)
@@ -204,25 +177,6 @@ class Beam(PotentialMixin):
         self._assembly = value
 
     # -- geometry helpers -------------------------------------------------
-    def _node_index(self, node, arg):
-        if isinstance(node, bool) or not isinstance(node, numbers.Integral):
-            raise ValueError(f"`{arg}` node must be an integer index, got {node!r}.")
-        if not -self.n_nodes <= node < self.n_nodes:
-            raise ValueError(f"`{arg}` node must be in [-{self.n_nodes}, {self.n_nodes - 1}] "
-                             f"(the beam has {self.n_nodes} nodes), got {node}.")
-        return int(node) % self.n_nodes
-
-    def _locate(self, s, arg="s"):
-        """Element index and normalised coordinate of axis point(s) at arc length s."""
-        s = np.atleast_1d(np.asarray(s, dtype=float))
-        total = self.s_nodes[-1]
-        if np.any(~np.isfinite(s)) or np.any(s < -1e-12 * total) or np.any(s > total * (1 + 1e-12)):
-            raise ValueError(f"`{arg}` must lie on the beam, in [0, {total}], got {s.tolist()}.")
-        ends = np.concatenate([[0.0], np.cumsum(self.lengths)])
-        e = np.clip(np.searchsorted(ends, s, side="right") - 1, 0, self.n_elements - 1)
-        loc = 2.0 * (s - ends[e]) / self.lengths[e] - 1.0
-        return e, np.clip(loc, -1.0, 1.0)
-
     def expand(self, q: np.ndarray) -> np.ndarray:
         """Full coordinate vector: free coordinates ``q``, fixed ones from the reference."""
         full = self.q_ref.copy()
@@ -267,105 +221,10 @@ class Beam(PotentialMixin):
         :func:`ancfdae.models._describe.dof_labels`."""
         return _describe.dof_labels(self)
 
-    # -- loads ------------------------------------------------------------
-    def _setup_loads(self, loads):
-        el, dim = self.element, self.element.dim
-        self._dead = []          # (time function, free-vector) of dead forces
-        self._moments = []       # (time, element, s_loc, moment3, scatter)
-        self._f_gravity = np.zeros(self.n_dof)
-        sq, wq = gauss(6)
-        S_all = el.shape_matrix(sq, self.lengths)                       # (n_el, n_pts, dim, nd)
-        w_el = wq[None, :] * self.lengths[:, None] / 2
-        for load in loads:
-            if isinstance(load, (PointForce, PointMoment)):
-                if load.node is not None:
-                    s = self.s_nodes[self._node_index(load.node, "load")]
-                else:
-                    s = load.s
-                (e,), (loc,) = self._locate(s, "load s")
-            if isinstance(load, PointForce):
-                F = load.force
-                if F.shape[0] != dim:
-                    raise ValueError(f"`force` must have {dim} components for {el.name}, got {F.shape[0]}.")
-                S = el.shape_matrix(np.array([loc]), self.lengths[[e]])[0, 0]
-                fe = np.zeros((self.n_elements, el.n_edof))
-                fe[e] = S.T @ F
-                self._dead.append((load.time, self._asm.vector(fe)))
-            elif isinstance(load, PointMoment):
-                if dim == 2 and load.moment.shape[0] != 1:
-                    raise ValueError(f"`moment` of a planar element must be a scalar, got {load.moment.tolist()}.")
-                self._moments.append((load.time, int(e), float(loc), load.vector3(), self._asm.element_scatter(int(e))))
-            elif isinstance(load, (Gravity, DistributedLoad)):
-                w = load.g if isinstance(load, Gravity) else load.w
-                if w.shape[0] != dim:
-                    raise ValueError(f"gravity/line load must have {dim} components for {el.name}, got {w.shape[0]}.")
-                rhoA = el.material.rho * el.section.A if isinstance(load, Gravity) else 1.0
-                fe = rhoA * np.einsum("ep,epdk,d->ek", w_el, S_all, w)
-                if isinstance(load, Gravity):
-                    self._f_gravity += self._asm.vector(fe)
-                else:
-                    self._dead.append((load.time, self._asm.vector(fe)))
-            else:
-                raise TypeError(f"`loads` entries must be PointForce, PointMoment, Gravity or DistributedLoad, "
-                                f"got {load!r}.")
-
-    def _f_nonconservative(self, t, q_full, tangent):
-        """Non-conservative external forces (free vector) and their q-derivative data."""
-        f = np.zeros(self.n_dof)
-        for time, vec in self._dead:
-            f += time(t) * vec
-        kdata = None
-        if self._moments:
-            kdata = np.zeros(self._asm.nnz) if tangent else None
-            for time, e, loc, m, (vmask, vidx, mmask, mslot) in self._moments:
-                scale = time(t)
-                if scale == 0.0:
-                    continue
-                fm, km = self.element.moment_load(self.geom, q_full[self.edofs[e]], loc, scale * m, e, tangent)
-                np.add.at(f, vidx, fm[vmask])
-                if tangent:
-                    np.add.at(kdata, mslot, km.ravel()[mmask])
-        return f, kdata
-
     # -- the Model contract -------------------------------------------------
-    def _check(self, q, v=None, a=None):
-        """Shape checks of the contract's arguments: a wrong length would otherwise assemble silently
-        into a wrong-sized residual or fail deep inside numpy."""
-        n = (self.n_dof,)
-        # Attribute access for arrays (tens of ns); anything else goes through np.shape in check_shape.
-        if getattr(q, "shape", None) != n:
-            check_shape("q", q, n, f"n_dof = {self.n_dof}")
-        if v is not None and getattr(v, "shape", None) != n:
-            check_shape("v", v, n, f"n_dof = {self.n_dof}")
-        if a is not None and getattr(a, "shape", None) != n:
-            check_shape("a", a, n, f"n_dof = {self.n_dof}")
-
     def initial_state(self):
         """Reference configuration and the initial velocity."""
         return self.q_ref[self.free].copy(), self._v0.copy()
-
-    def _initial_velocity(self, iv):
-        nnd = self.element.n_node_dof
-        if iv is None:
-            return np.zeros(self.n_dof)
-        if callable(iv):
-            dim = self.element.dim
-            V = np.zeros((self.n_nodes, nnd))
-            v = np.asarray(iv(self.points), dtype=float)
-            if v.shape != self.points.shape or not np.all(np.isfinite(v)):
-                raise ValueError(f"`initial_velocity` must return finite velocities of shape {self.points.shape}, "
-                                 f"got {v.shape}.")
-            V[:, :dim] = v
-            names = self.element.node_coordinates
-            if len(names) >= 2 * dim and names[dim].endswith("'"):
-                h = 1e-5 * float(self.lengths.min())
-                t = self.frames[:, :, 0]
-                V[:, dim:2 * dim] = (np.asarray(iv(self.points + h * t)) - np.asarray(iv(self.points - h * t))) / (2 * h)
-            return V.reshape(-1)[self.free]
-        V = np.asarray(iv, dtype=float)
-        if V.shape != (self.n_nodes, nnd) or not np.all(np.isfinite(V)):
-            raise ValueError(f"`initial_velocity` array must be finite with shape {(self.n_nodes, nnd)}, got {V.shape}.")
-        return V.reshape(-1)[self.free]
 
     def mass(self, q=None) -> sp.csr_matrix:
         """Mass matrix M(q) (constant unless the element says otherwise; ``q=None``: the reference state)."""
@@ -389,20 +248,6 @@ class Beam(PotentialMixin):
     def _element_q(self, q):
         """Element coordinates (n_el, n_edof) of free coordinates ``q`` (= ``expand(q)[edofs]``)."""
         return np.concatenate((q, self._q_fixed))[self._gather]
-
-    def _f_external(self, t, q, tangent):
-        """``fnc + f_gravity`` (free vector) and the load tangent data (or None); skips the
-        non-conservative pass when the beam has no such loads (bit-for-bit: 0 + f_g = f_g)."""
-        if not self._moments:
-            if not self._dead:
-                return self._f_gravity, None
-            time, vec = self._dead[0]
-            f = time(t) * vec
-            for time, vec in self._dead[1:]:
-                f += time(t) * vec
-            return f + self._f_gravity, None
-        fnc, kload = self._f_nonconservative(t, self.expand(q), tangent)
-        return fnc + self._f_gravity, kload
 
     def _fused(self, geom):
         """The element's fused entry point ``(fn, args)`` for ``geom``, or None (NumPy assembly)."""
@@ -443,73 +288,6 @@ class Beam(PotentialMixin):
         if not self.mass_is_constant:
             r += self._inertia(q, v, a, False)[0]
         return r
-
-    def residual_stages(self, ts, Q, V, A):
-        """Residuals of several stages in one element pass: column ``i`` of the (n_dof, m) result is
-        ``residual(ts[i], Q[:, i], V[:, i], A[:, i])`` (optional Model method; Lobatto IIIA uses it).
-
-        The element kernel runs once on the stages' elements stacked (a geometry for ``m`` copies of
-        the mesh, prepared on first use), which halves the per-call overhead of small meshes.
-        """
-        m = np.size(ts)
-        if np.ndim(ts) != 1 or np.shape(Q) != (self.n_dof, m) or np.shape(V) != (self.n_dof, m) \
-                or np.shape(A) != (self.n_dof, m):
-            check_shape("ts", ts, (m,), "one time per stage")
-            for name, X in (("Q", Q), ("V", V), ("A", A)):
-                check_shape(name, X, (self.n_dof, m), f"(n_dof, number of stages) = ({self.n_dof}, {m})")
-        ts = np.asarray(ts, dtype=float)
-        m = ts.size
-        if not self.mass_is_constant:
-            return np.column_stack([self.residual(ts[i], Q[:, i], V[:, i], A[:, i]) for i in range(m)])
-        geom, gather, idx = self._stage_geometry(m)
-        n = self.n_dof
-        fused = self._fused(geom)
-        if fused is None:
-            ext = np.empty((n + self._q_fixed.size, m))   # (free q; fixed values) per stage, stage fastest
-            ext[:n] = Q
-            ext[n:] = self._q_fixed[:, None]
-            fe, _ = self.element.internal_forces(geom, ext.ravel().take(gather), False)
-            F = np.bincount(idx, weights=fe.ravel(), minlength=m * (n + 1))
-            F = F.reshape(m, n + 1)[:, :n].T
-            R = F + self._M_csr @ A
-            if not self._dead and not self._moments:
-                R -= self.load_factor * self._f_gravity[:, None]
-            else:
-                for i in range(m):
-                    R[:, i] -= self.load_factor * self._f_external(ts[i], Q[:, i], False)[0]
-            return R
-        fn, args = fused
-        F = np.empty((m, n + 1))
-        q_fixed_m, gravity_m = self._stage_constants(m)
-        fn(np.ascontiguousarray(Q, dtype=float).reshape(-1), q_fixed_m, gather, idx,
-           self._asm._slot_all, False, F.reshape(-1), self._no_k, *args)
-        if not self._dead and not self._moments:
-            fext = gravity_m
-        else:
-            fext = np.column_stack([self._f_external(ts[i], Q[:, i], False)[0] for i in range(m)])
-        R = np.empty((n, m))
-        _finish_stages()(F, self._M_data, self._asm.indptr, self._asm.indices, np.ascontiguousarray(A, dtype=float),
-                         float(self.load_factor), fext, R)
-        return R
-
-    def _stage_constants(self, m):
-        """The fixed coordinates repeated per stage and the gravity force per stage, (n, m) (cached)."""
-        cache = self.__dict__.setdefault("_stage_const", {})
-        if m not in cache:
-            cache[m] = (np.repeat(self._q_fixed, m), np.repeat(self._f_gravity[:, None], m, axis=1))
-        return cache[m]
-
-    def _stage_geometry(self, m):
-        """Element geometry of ``m`` stacked copies of the mesh and the matching scatter index."""
-        cache = self.__dict__.setdefault("_stage_cache", {})
-        if m not in cache:
-            q_ref_e = self.q_ref[self.edofs]
-            geom = self.element.prepare(np.tile(q_ref_e, (m, 1)), np.tile(self.lengths, m))
-            vec_all = self._asm._vec_all
-            idx = (np.arange(m)[:, None] * (self.n_dof + 1) + vec_all[None, :]).ravel()
-            gather = (self._gather[None] * m + np.arange(m)[:, None, None]).reshape(-1, self._gather.shape[1])
-            cache[m] = (geom, gather, idx)
-        return cache[m]
 
     def residual_jacobian(self, t, q, v, a):
         """``(residual, jacobian)`` from one kernel pass (the fused path of full Newton)."""
@@ -552,40 +330,3 @@ class Beam(PotentialMixin):
         # Gravity's potential, zero in the reference configuration.
         V = -self.load_factor * float(self._f_gravity @ (q - self.q_ref[self.free]))
         return Energy(kinetic=float(T), strain=U, potential=V)
-
-    def external_power(self, t, q, v) -> float:
-        """Power of all loads except gravity (whose work is the potential)."""
-        self._check(q, v)
-        f, _ = self._f_nonconservative(t, self.expand(q), False)
-        return float(self.load_factor * f @ v)
-
-    # -- capabilities and event state (ancfdae.problem.CAPABILITIES) --------------------------
-    @property
-    def capabilities(self) -> frozenset:
-        """The optional capabilities this beam offers (see :func:`ancfdae.problem.capabilities`)."""
-        caps = {"residual_jacobian", "residual_stages"}
-        if not self.mass_is_constant:
-            caps.add("variable_mass")
-        else:
-            caps.add("potential")       # M a + dP/dq - f_nc with a constant M (PotentialMixin)
-        if self.element.event_state(self.geom):
-            caps.add("step_events")
-        return frozenset(caps)
-
-    def event_state(self) -> dict:
-        """The element's event state (BE3D: ``{"directors": (n_nodes, 3)}``), read-only arrays."""
-        return dict(self.element.event_state(self.geom))
-
-    def bind(self, state: dict) -> "Beam":
-        """A beam evaluating with the event ``state``, sharing everything else (this one is unchanged)."""
-        other = copy.copy(self)
-        other.geom = self.element.bind(self.geom, state)
-        return other
-
-    def step_event(self, t, q, v):
-        """The element's event after an accepted step (BE3D director update); None when nothing changed."""
-        ev = self.element.step_event(self.geom, self.nodal(q), self._expand_v(v).reshape(self.n_nodes, -1))
-        if ev is None:
-            return None
-        Q, V, state = ev
-        return Q.reshape(-1)[self.free], V.reshape(-1)[self.free], state

@@ -11,7 +11,7 @@ import numpy as np
 
 from .._validate import finite_vector, positive_int
 from ._element import Element
-from ._kernel_option import resolve_kernel
+from ._kernel_option import KernelOption
 from ._shapes import hermite
 from ._thin import (PointRule, assemble, axial_energy, check_material_section, clamp_coordinates,
                     hermite_operator, translational_mass)
@@ -26,7 +26,7 @@ _SYM_RTOL = 1e-10
 _STRAIGHT_TOL = 1e-10
 
 
-class Cable3D(Element):
+class Cable3D(KernelOption, Element):
     """Spatial thin ANCF beam without torsional stiffness (chapter Sect. 3.4).
 
     Strain energy (structural formulation, chapter Eqs. 37 and 40 with the
@@ -86,21 +86,6 @@ class Cable3D(Element):
         self.axial_points = positive_int("axial_points", axial_points)
         self.bending_points = positive_int("bending_points", bending_points)
         self.kernel = kernel
-
-    @property
-    def kernel(self) -> str:
-        """The ``kernel`` option as given ("auto", "numpy" or "numba")."""
-        return self._kernel
-
-    @kernel.setter
-    def kernel(self, value):
-        self._impl = resolve_kernel(value)
-        self._kernel = value
-
-    @property
-    def kernel_in_use(self) -> str:
-        """The implementation that runs: "numpy" or "numba"."""
-        return self._impl
 
     def __repr__(self):
         return (f"Cable3D(axial_points={self.axial_points}, bending_points={self.bending_points}, "
