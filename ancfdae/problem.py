@@ -16,7 +16,7 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["Model", "JacobianBlocks", "Energy", "CAPABILITIES", "capabilities"]
+__all__ = ["Model", "JacobianBlocks", "Energy", "CAPABILITIES", "capabilities", "PotentialModel"]
 
 
 @dataclass(frozen=True)
@@ -146,11 +146,17 @@ class Model(Protocol):
 #:     ``step_event(t, q, v) -> None or (q, v, state)`` called after every accepted step, None meaning
 #:     nothing changed. The driver carries the state, restarts the integrator when it changes and
 #:     stores it in ``Result.model_state``.
+#: ``"potential"``
+#:     the residual splits as ``M a + dP/dq - f_nc(t, q)`` with a constant ``M``:
+#:     ``potential``, ``potential_gradient``, ``nonconservative_force`` (and optionally
+#:     ``symmetry_generators``, ``potential_degree``), see :class:`PotentialModel`
+#:     (energy-momentum integrators).
 CAPABILITIES: dict[str, tuple[str, ...]] = {
     "residual_jacobian": ("residual_jacobian",),
     "residual_stages": ("residual_stages",),
     "variable_mass": (),
     "step_events": ("event_state", "bind", "step_event"),
+    "potential": ("potential", "potential_gradient", "nonconservative_force"),
 }
 
 
@@ -189,3 +195,48 @@ def capabilities(model) -> frozenset:
     if "variable_mass" in declared and getattr(model, "mass_is_constant", False):
         raise TypeError(f"{type(model).__name__} declares 'variable_mass' but mass_is_constant is True.")
     return declared
+
+
+# -- optional capability: the potential, for energy-momentum integrators ---------------------
+@runtime_checkable
+class PotentialModel(Protocol):
+    """What a structure-preserving (discrete-gradient) integrator needs beyond :class:`Model`.
+
+    The residual splits as ``r = M a + dP/dq - f_nc(t, q)`` with a *constant* mass
+    matrix, the conservative potential ``P = U + V`` (strain energy plus the
+    potential of the conservative loads, i.e. gravity) and the non-conservative
+    loads ``f_nc`` (dead forces, moments). Optional: a model offers it by declaring
+    the ``"potential"`` capability (:data:`CAPABILITIES`); ``symmetry_generators``
+    and ``potential_degree`` are optional within it.
+
+    Attributes
+    ----------
+    potential_degree : int or None
+        Polynomial degree of ``P`` in ``q`` when ``P`` is a polynomial (4 for
+        the St. Venant-Kirchhoff continuum formulations, whose Green strain is
+        quadratic in ``q``), else None.
+    """
+
+    potential_degree: int | None
+
+    def potential(self, t: float, q: np.ndarray) -> float:
+        """``P(q) = U(q) + V(q)`` (equal to ``energy(t, q, v).strain + .potential``)."""
+        ...
+
+    def potential_gradient(self, t: float, q: np.ndarray, tangent: bool = True):
+        """``(dP/dq, d2P/dq2 as a sparse matrix or None)``."""
+        ...
+
+    def nonconservative_force(self, t: float, q: np.ndarray, tangent: bool = True):
+        """``(f_nc(t, q), df_nc/dq as a sparse matrix or None)``; ``external_power = f_nc . v``."""
+        ...
+
+    def symmetry_generators(self):
+        """Rigid motions that leave the strain energy unchanged: ``(T, A)``.
+
+        ``T`` (n_dof, k_t): constant translation directions; ``A``: list of
+        sparse skew matrices, the infinitesimal rotations ``q -> A q`` (rotating
+        every nodal vector). Both empty when supports break the symmetry.
+        """
+        ...
+

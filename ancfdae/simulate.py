@@ -1,4 +1,4 @@
-"""``simulate``: the one front door to the integrators (design.md Sect. 2, 5).
+"""``simulate``: the one front door to the integrators.
 
 Imitates scipy's ``solve_ivp``: a ``METHODS`` registry, options forwarded to
 the integrator, and a :class:`~ancfdae.result.Result` that reports failure in
@@ -12,6 +12,7 @@ from __future__ import annotations
 import inspect
 
 from ancfdae.integrators.driver import integrate
+from ancfdae.integrators.energy_momentum import EnergyMomentum
 from ancfdae.integrators.ida import IDA
 from ancfdae.integrators.lobatto import LobattoIIIA
 from ancfdae.integrators.newmark import GeneralizedAlpha, HHTAlpha, Newmark
@@ -48,6 +49,7 @@ METHODS = {
     "hht": HHTAlpha,
     "generalized-alpha": GeneralizedAlpha,
     "ida": IDA,
+    "energy-momentum": EnergyMomentum,
 }
 
 
@@ -102,7 +104,9 @@ def simulate(model, t_span, method="lobatto3", h=None, t_eval=None, monitors=(),
     method : str, Integrator subclass or Integrator instance
         A key of :data:`METHODS` -- ``"lobatto3"`` (default, the chapter's
         Lobatto IIIA, order 4), ``"lobatto2"``, ``"newmark"``, ``"hht"``,
-        ``"generalized-alpha"``, ``"ida"`` -- or a class written against
+        ``"generalized-alpha"``, ``"ida"``, ``"energy-momentum"`` (constant
+        mass matrix and the ``"potential"`` capability: energy and momenta
+        kept exactly) -- or a class written against
         :class:`ancfdae.integrators.protocol.Integrator` (built with
         ``cls(model, h, **options)`` or ``cls(model, **options)``), or a
         constructed instance (then no ``h`` or options here).

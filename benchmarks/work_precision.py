@@ -23,7 +23,8 @@ Printed: every run (method, step or rtol, CPU s, error, Newton iterations per st
 then at each accuracy level reached by an Exudyn run the cheapest run of each side at least as
 accurate and the ratio ours / Exudyn's best (< 1: ours faster). "Cheapest run at least as
 accurate" is a step function of the sampled step sizes: it favours neither side systematically but
-is coarse; the per-run table is the full picture.
+is coarse, so the ratio is also given with our cost interpolated (log-log, between the two runs of
+one method that bracket the level); the per-run table is the full picture.
 """
 from __future__ import annotations
 
@@ -150,9 +151,25 @@ def summary(rows):
                   f"no run of ours this accurate")
             continue
         o_best = min(o, key=lambda r: r[1])
+        interp = _interpolated_cost(us, level)
         print(f"  {level:9.2e} m: Exudyn {e_best[0][1]} h={e_best[0][2]:g} {e_best[1]:.3f} s | ours "
               f"{o_best[0][1]} {o_best[0][2]:g} {o_best[1]:.3f} s (error {o_best[2]:.1e}) | ratio "
-              f"{o_best[1] / e_best[1]:.2f}", flush=True)
+              f"{o_best[1] / e_best[1]:.2f}" + (f" (log-log interpolated: {interp / e_best[1]:.2f})"
+                                                  if interp is not None else ""), flush=True)
+
+
+def _interpolated_cost(runs, level):
+    """Cheapest cost of ours at error ``level``, interpolating each method's log(cost) over log(error)
+    between its sampled runs (None if no method's runs bracket the level)."""
+    best = None
+    for method in {r[0][1] for r in runs}:
+        pts = sorted((r[2], r[1]) for r in runs if r[0][1] == method)
+        for (e0, c0), (e1, c1) in zip(pts, pts[1:]):
+            if e0 <= level <= e1 and e1 > e0:
+                w = np.log(level / e0) / np.log(e1 / e0)
+                c = float(np.exp((1 - w) * np.log(c0) + w * np.log(c1)))
+                best = c if best is None else min(best, c)
+    return best
 
 
 def main(argv=None):

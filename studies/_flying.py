@@ -1,6 +1,6 @@
 """The free flying beams of benchmarks B2 and B3 (chapter Sects. 5.2, 5.3) and their shared tools.
 
-Both beams (benchmarks B2, B3 of ancfdae): L = 1 m, square section a = 0.05 m, E = 1e5 N/m^2,
+Both beams (the project's B2/B3 definitions, revision 2): L = 1 m, square section a = 0.05 m, E = 1e5 N/m^2,
 nu = 0.3, rho = 2500 kg/m^3 (chapter Eq. 114), free-free, straight and at
 rest along ``r(s) = s (0.6, 0.8[, 0])``; B is the end s = 0.
 
@@ -84,7 +84,7 @@ def b2_beam(name: str, n_elements: int, E_scale: float = 1.0, **element_options)
 def b3_beam(name: str, n_elements: int, t_load: float = T_HAT, scale: float = 1.0, **element_options):
     """B3, the beam flying in space (3D element types only).
 
-    ``t_load`` (end of the hat, 3 s) and ``scale`` (of the
+    ``t_load`` (end of the hat: 3 s) and ``scale`` (of the
     moment) give the shorter, gentler variant of the quick modes.
     """
     el = _element(name, **element_options)

@@ -1,11 +1,11 @@
 """Energy drift in long free motion: every element x integrator pair (chapter Sect. 5.3).
 
 The planar elements fly as in B2 (force and moment pulse, ends at 2.5 s), the
-spatial ones as in B3 (moment hat, ends at 3 s), the benchmarks of :mod:`studies._flying`;
+spatial ones as in B3 (moment hat, ends at 3 s), both as the project defines them;
 after the load the motion is free and the total energy ``T + U`` of the exact
 solution is constant. Each element type is integrated by Lobatto IIIA (3 and
 2 stages, modified Newton), Newmark (beta 1/4, gamma 1/2), HHT (alpha 0.05),
-generalized-alpha (rho_inf 0.8) and IDA (BDF, default maximum order), and the study
+generalized-alpha (rho_inf 0.8) and IDA (BDF, max order 5), and the study
 records the balance ``E(t) = T + U - W_ext`` against time, the drift after the
 load (largest ``|E - E(t_load)|``, fitted rate dE/dt, relative to the energy
 at the end of the load), the time the energy monitor flags a blow-up (drift

@@ -1,11 +1,11 @@
 """Integrators compared on B2: work-precision, Newton work per step, energy drift.
 
-The B2 beam (:mod:`studies._flying`; a small mesh of BE2D) and a stiffer variant
+The B2 beam (the project's definition; a small mesh of BE2D) and a stiffer variant
 (Young's modulus x 100: its axial and bending frequencies x 10) are integrated
 over [0, T] by Lobatto IIIA with 3 and 2 stages (modified and full Newton),
 Newmark (beta 1/4, gamma 1/2), HHT (alpha 0.05), generalized-alpha
 (rho_inf 0.8) over a range of step sizes, by Lobatto IIIA (3 stages) over a
-range of Newton tolerances, and by IDA (BDF at its default maximum order, reported in the table)
+range of Newton tolerances, and by IDA (BDF, max order 5)
 over a range of relative tolerances. The error of a run is the integrated tip
 error of chapter Eq. 115 against a fine reference (Lobatto IIIA, 3 stages,
 h = 1.25e-4 s, full Newton, tol 1e-10; T = 4 s, so the pulse -- 2.5 s -- and
@@ -18,8 +18,7 @@ over the run (the work of the loads integrated along, see EnergyMonitor) and
 the drift after the pulse; per method the observed order (log-log fit of
 eps_T against h).
 
-IDA runs set ``OMP_NUM_THREADS=1`` (with a busy second core the threaded
-sparse solver of SUNDIALS slowed down up to 4x); set it in the shell
+IDA runs set ``OMP_NUM_THREADS=1`` (measured: with a busy second core the bundled OpenMP threads made IDA's solvers several times slower); set it in the shell
 before the study starts to be sure it takes effect.
 
 Run: ``ancfdae study integrators [--quick] [--out DIR] [--jobs N]``.

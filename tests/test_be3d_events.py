@@ -76,3 +76,19 @@ def test_a_run_resumes_from_its_saved_state():
     np.testing.assert_allclose(rest.model_state["directors"][-1], whole.model_state["directors"][-1], atol=1e-8)
     with pytest.raises(ValueError, match="state0"):
         simulate(b3(), (0.2, 0.4), "lobatto3", h=1e-3, state0={"directors": np.zeros(2)})
+
+
+def _rss_mb():
+    with open("/proc/self/status") as f:
+        return next(int(line.split()[1]) / 1024 for line in f if line.startswith("VmRSS"))
+
+
+@pytest.mark.skipif(not __import__("os").path.exists("/proc/self/status"), reason="needs Linux /proc")
+def test_ida_restarts_do_not_grow_memory():
+    """The defect: every re-initialisation leaked inside SuperLU_MT (measured 350 kB per restart at 8 elements,
+    2.7 MB at 64). 300 forced restarts with the default linear solver must not grow the resident set."""
+    simulate(b3(8), (0, 0.2), "ida", rtol=1e-6, max_steps=20, t_eval=[0.0])   # warm-up: imports, caches
+    r0 = _rss_mb()
+    res = simulate(b3(8), (0, 0.2), "ida", rtol=1e-6, max_steps=300, t_eval=[0.0])
+    assert res.stats["restarts"] == 300 and res.options["linsolver"] == "band"
+    assert _rss_mb() - r0 < 20.0

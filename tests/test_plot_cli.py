@@ -96,3 +96,12 @@ def test_cli_version_export_animate(run2d, tmp_path, capsys):
 def test_python_dash_m():
     out = subprocess.run([sys.executable, "-m", "ancfdae", "--version"], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == f"ancfdae {ancfdae.__version__}"
+
+
+def test_no_backend_switch_in_library_or_studies():
+    """A notebook user's backend survives importing and plotting: no matplotlib.use anywhere."""
+    from pathlib import Path
+    root = Path(__file__).resolve().parents[1]
+    hits = [str(p.relative_to(root)) for base in ("ancfdae", "studies") for p in (root / base).rglob("*.py")
+            if "matplotlib.use(" in p.read_text()]
+    assert not hits, f"matplotlib.use in {hits}"

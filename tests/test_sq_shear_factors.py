@@ -9,6 +9,8 @@ reduces to at small loads -- which separates k2 and k3; a tip torque, ``T L / (G
 bending axis (exact in the structural formulation; independent of the shear factors, so it checks that
 the example runs with k2 != k3 through the public API and that I2/I3 are not swapped).
 """
+import importlib.util
+
 import numpy as np
 import pytest
 
@@ -31,7 +33,8 @@ def _cantilever(element, L, load, n=4):
     return beam, res
 
 
-@pytest.mark.parametrize("kernel", ["numpy", "numba"])
+@pytest.mark.parametrize("kernel", ["numpy", pytest.param("numba", marks=pytest.mark.skipif(
+    importlib.util.find_spec("numba") is None, reason="numba not installed"))])
 def test_tip_forces_separate_k2_and_k3(mat, kernel):
     """Catches k2 and k3 swapped or one factor used for both (the shear part is ~13 % of the deflection)."""
     L, P = 1.0, 1e3

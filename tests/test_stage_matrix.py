@@ -64,3 +64,20 @@ def test_lobatto3_modified_newton_in_eigenbasis_gives_the_full_newton_steps():
             for j in ("modified", "full")]
     assert all(r.status == "success" for r in runs)
     assert np.abs(runs[0].q[-1] - runs[1].q[-1]).max() <= 1e-10 * np.abs(runs[1].q[-1]).max()
+
+
+def test_lobatto3_falls_back_to_the_per_stage_matrix_when_the_eigenbasis_newton_fails(monkeypatch):
+    # Catches: a step that fails with the one-state eigenbasis matrix although the exact per-stage
+    # matrix converges (the fallback must run before the step is declared failed).
+    from ancfdae import simulate
+    from ancfdae.integrators import _linsolve
+
+    class Useless(_linsolve.StageMatrix):   # a stage matrix whose corrections are 0: never converges
+        def factorize(self):
+            return type("Z", (), {"solve": staticmethod(lambda r: 0.0 * r)})()
+
+    monkeypatch.setattr("ancfdae.integrators.lobatto.StageMatrix", Useless)
+    beam = Beam(BE2D(Material(2.1e10, 0.3, 4000.0), RectangularSection(0.05)), 4, 1.0,
+                supports={0: ("x", "y")}, loads=[Gravity((0.0, -9.81))])
+    res = simulate(beam, (0.0, 0.005), "lobatto3", h=1e-3, newton={"tol": 1e-10, "max_iter": 8})
+    assert res.status == "success"

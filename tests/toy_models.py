@@ -2,7 +2,8 @@
 
 SpringChain  -- planar chain of point masses joined by geometrically nonlinear springs, hinged at
                 the origin, gravity, optional pulse force on the last mass and Rayleigh-type damping;
-                constant mass, banded sparse matrices sharing one CSR pattern, ``position(q, s)``.
+                constant mass, banded sparse matrices sharing one CSR pattern, ``position(q, s)``,
+                and the PotentialModel capability (potential, its gradient, the pulse force apart).
 DoublePendulum -- angles as coordinates: configuration-dependent mass, velocity-dependent terms,
                 optional pulse torque on the first joint.
 """
@@ -44,7 +45,7 @@ class SpringChain:
     """N point masses in the plane; spring i joins mass i-1 (or the hinge at the origin) and mass i."""
 
     mass_is_constant = True
-    capabilities = frozenset({"step_events"})   # records the accepted steps (self.accepted)
+    capabilities = frozenset({"step_events", "potential"})   # step_events: records the accepted steps
 
     def __init__(self, n_masses=3, mass=1.0, k=200.0, l0=1.0, g=9.81, force=(0.0, 0.0), T=1.0,
                  damping=0.0, v0=None, hinge=True):
@@ -135,6 +136,22 @@ class SpringChain:
 
     def external_power(self, t, q, v):
         return float(pulse(t, self.T)) * float(self.F0 @ v[-2:])
+
+    # -- PotentialModel (ancfdae.problem): for the energy-momentum integrator --------------------
+    potential_degree = None
+
+    def potential(self, t, q):
+        e = self.energy(t, q, np.zeros_like(q))
+        return e.strain + e.potential
+
+    def potential_gradient(self, t, q, tangent=True):
+        fint, _ = self._fint(q)
+        g = fint - self._fext(-1.0)          # gravity only (the pulse is zero before t = 0)
+        return g, (self.jacobian(t, q, q, q).K if tangent else None)
+
+    def nonconservative_force(self, t, q, tangent=True):
+        f = self._fext(t) - self._fext(-1.0)
+        return f, (sp.csr_matrix(self._M.shape) if tangent else None)
 
     def position(self, q, s):
         """Piecewise-linear 'axis' through hinge and masses; s in [0, N] (affine in q)."""

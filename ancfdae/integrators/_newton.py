@@ -1,4 +1,4 @@
-"""Newton and modified Newton iteration with LU reuse (design.md Sect. 5).
+"""Newton and modified Newton iteration with LU reuse.
 
 The chapter (Sect. 5.1) solves each load step with a classical Newton method
 and (Sect. 5.2) each time step with a *modified* Newton method that updates
@@ -108,7 +108,25 @@ class NewtonOptions:
 
 @dataclass
 class NewtonStats:
-    """Work counters; ``a + b`` adds them field by field."""
+    """Work counters; ``a + b`` adds them field by field.
+
+    Parameters
+    ----------
+    iterations : int
+        Newton iterations (linear solves with a correction).
+    residual_evals : int
+        Residual evaluations.
+    jacobian_evals : int
+        Jacobian evaluations.
+    factorizations : int
+        LU factorisations.
+    solves : int
+        Calls of :meth:`NewtonSolver.solve`.
+    failed_solves : int
+        Solves that did not converge.
+    retries : int
+        Modified-Newton retries with a fresh matrix.
+    """
 
     iterations: int = 0
     residual_evals: int = 0

@@ -152,8 +152,30 @@ def integrate(stepper, model, t_span, t_eval=None, monitors=(), hooks=(), q0=Non
               max_steps=None, progress=False):
     """Run ``stepper`` (an :class:`~.protocol.Integrator`) on ``model`` over ``t_span``.
 
-    Parameters are those of :func:`ancfdae.simulate` (which builds the stepper); ``state0`` is the
-    model's event state to start from (a dict like one row of ``Result.model_state``).
+    Parameters
+    ----------
+    stepper : Integrator
+        The stepper, constructed on ``model``.
+    model : Model
+        The equations of motion.
+    t_span : (t0, tf)
+        Time interval.
+    t_eval : array_like, optional
+        Output times (default: every step).
+    monitors : sequence of Monitor
+        Logged at the output times.
+    hooks : sequence of callables
+        ``hook(t, q, v, a)`` after every accepted step; True ends the run.
+    q0, v0 : array_like, optional
+        Initial state (default ``model.initial_state()``).
+    state0 : dict, optional
+        The model's event state to start from (a dict like one row of ``Result.model_state``).
+    max_steps : int, optional
+        Limit on the number of steps.
+    progress : bool
+        Show a progress bar.
+
+    These are the parameters of :func:`ancfdae.simulate`, which builds the stepper.
 
     Returns
     -------

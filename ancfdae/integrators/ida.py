@@ -59,15 +59,22 @@ class IDA(Integrator):
         run time. The velocity tolerance decides the cost on stiff beams: on the 25-element
         BE2D pendulum (0.2 s, rtol 1e-6) the default resolved the axial vibrations (8,903
         steps, tip error 8e-7) while ``atol=(1e-6, 1e-2)`` took 217 steps (tip error 1.5e-4).
+        On B2 (8 BE2D elements, [0, 4] s) the cost stays near 3,500 steps from rtol 1e-4 to
+        1e-6 because the default resolves the axial vibrations; a looser velocity tolerance
+        did not reach a given eps_T any cheaper (rtol 1e-4, ``atol=(rtol, 10 rtol)``: 333 steps
+        but eps_T 6.9e-4 against 4.3e-6; rtol 1e-6, ``(rtol, 100 rtol)``: 4.7e-6 against 4.2e-8
+        at the same step count).
     max_order : int in [1, 5]
         BDF order limit (default 5, see Notes).
     max_step, first_step : float, optional
         0 = chosen by IDA.
-    linsolver : {"sparse", "band", "dense"}
-        "sparse" (default): SuperLU_MT on the exact Jacobian's pattern. "band": SUNDIALS band
-        solver on the node-interleaved ordering ``[q_0, v_0, q_1, v_1, ...]`` that keeps the
-        band of the model's matrices (scikit-sundae hands the Jacobian over as a full N x N
-        array: 8 N^2 bytes). "dense": for tiny models.
+    linsolver : {"auto", "band", "sparse", "dense"}
+        "band": SUNDIALS band solver on the node-interleaved ordering ``[q_0, v_0, q_1, v_1,
+        ...]`` that keeps the band of the model's matrices (scikit-sundae hands the Jacobian over
+        as a full N x N array, N = 2 n_dof: 8 N^2 bytes). "sparse": SuperLU_MT on the exact
+        Jacobian's pattern (no N x N array, but it leaks memory at every re-initialisation, see
+        Notes). "dense": for tiny models. "auto" (default): "band" up to N = 2000 (32 MB), else
+        "sparse".
 
     Notes
     -----
@@ -79,22 +86,28 @@ class IDA(Integrator):
     order <= 3: 1.2e-4 / 6.3e-6 / 4.6e-7 (9,500 steps, 1.6-2.0 s); order <= 2: 3.9e-4 /
     5.7e-5 / 5.4e-6 (0.5-1.3 s), and 2.8e-8 only at rtol 1e-9 after 77,559 steps and 10.5 s.
     CPU to reach eps_T = 1e-6: 0.9 s (order 5), 1.4 s (4), 2.0 s (3), 1.9 s (2); Lobatto IIIA-3
-    0.7 s. The integrator study's problems (4 elements, [0, 2] s): B2, order 5 was 30-75x more
-    accurate at equal or lower CPU for rtol 1e-5..1e-7; B2 with E x 100, orders 3-5 are held by
-    stability, not accuracy (about 8,000 steps whatever rtol, eps_T 6.5e-8 at rtol 1e-6), where
+    0.7 s; measured again with medians of 3 interleaved runs: IDA default 0.65 s, Lobatto
+    0.57 s (at eps_T 4e-8 IDA took 0.66 s, Lobatto 0.95 s for 6.8e-8). The integrator study's
+    problems (4 elements, [0, 2] s): B2, order 5 was 30-75x more accurate at equal or lower
+    CPU for rtol 1e-5..1e-7; B2 with E x 100, orders 3-5 are held by stability, not accuracy
+    (about 8,000 steps whatever rtol, eps_T 6.5e-8 at rtol 1e-6), where
     order 2 reached 7e-7 in 1,865 steps (rtol 1e-7): for stiff undamped beams at moderate
     accuracy ``max_order=2`` can be cheaper. (The order-2 cap of earlier versions came from a
     linear chain, where BDF 3-5, not A-stable, forced tiny steps.)
 
-    Linear solver: "sparse" by default. On B2 above, "band" on the node-interleaved ordering
-    cost the same (0.80 vs 0.86 s to eps_T = 1e-6, within the noise of the shared machine), but
-    scikit-sundae hands a band Jacobian over as a full N x N array (8 N^2 bytes).
+    Linear solver, measured: on B2 above "band" on the node-interleaved ordering cost the same
+    as "sparse" (0.80 vs 0.86 s to eps_T = 1e-6, within the noise of the shared machine). Each
+    re-initialisation (a model event) leaks memory inside SuperLU_MT: B3 with 8 BE3D elements,
+    3,000 restarts grew the resident set from 62 to 1,113 MB with "sparse" and by 0.8 MB with
+    "band". Hence "band" by default while its N x N array is small.
 
     BE3D: an update of the directors is a model event and re-initialises IDA (order 1, small
     first step). Updating after every step is unusable with IDA: on B3 (2 elements, rtol 1e-6)
     20,000 steps and 20,000 restarts reached only t = 0.055 s in 100 s CPU, while with
     ``BE3D(update_below=0.5)`` 0.2 s took 41 steps, no restart, 0.09 s CPU. Use
-    ``update_below`` with IDA.
+    ``update_below`` with IDA. A run that starts at rest under a load that starts from zero
+    has a stationary initial state: IDA's first step then scales with the span (a run over
+    [0, 1e6] s stepped over a 3 s load); give ``max_step`` for long spans.
 
     Statistics: ``newton_iterations`` counts calls of the residual, which SUNDIALS' Newton
     solver evaluates exactly once per iteration (the Jacobian is ours, no difference
@@ -108,7 +121,7 @@ class IDA(Integrator):
     consistent_restart = True
 
     def __init__(self, model, rtol=1e-6, atol=None, *, max_order=5, max_step=0.0, first_step=0.0,
-                 linsolver="sparse"):
+                 linsolver="auto"):
         self.n_dof = check_model(model)
         super().__init__(model, None)
         self.rtol = V.positive("rtol", rtol)
@@ -124,7 +137,8 @@ class IDA(Integrator):
         self.max_order = int(max_order)
         self.max_step = V.nonnegative("max_step", max_step)
         self.first_step = V.nonnegative("first_step", first_step)
-        self.linsolver = V.choice("linsolver", linsolver, ("sparse", "band", "dense"))
+        self.linsolver = V.choice("linsolver", linsolver, ("auto", "band", "sparse", "dense"))
+        self._ls = self.linsolver if self.linsolver != "auto" else ("band" if 2 * self.n_dof <= 2000 else "sparse")
         self._solver = None
 
     def options(self) -> dict:
@@ -133,7 +147,7 @@ class IDA(Integrator):
         if atol is not None:
             atol = np.atleast_1d(np.asarray(atol, float)).tolist()
         return {"rtol": self.rtol, "atol": atol, "max_order": self.max_order, "max_step": self.max_step,
-                "first_step": self.first_step, "linsolver": self.linsolver}
+                "first_step": self.first_step, "linsolver": self._ls}
 
     def _atol(self, q0, span):
         n = self.n_dof
@@ -162,7 +176,7 @@ class IDA(Integrator):
         self._n_jac += 1
         q, v, a = self._split(y, yp)
         blk = self.model.jacobian(t, q, v, a)
-        if self.linsolver == "sparse":
+        if self._ls == "sparse":
             self._filler.fill(JJ, blk, cj)
         else:
             self._filler.fill(self._buf, blk, cj)
@@ -189,11 +203,11 @@ class IDA(Integrator):
         self._filler = _JacobianFiller(blocks0, n)
         self._perm = None
         opts = dict(rtol=self.rtol, max_order=self.max_order, jacfn=self._jacfn, max_step=self.max_step,
-                    first_step=self.first_step, linsolver=self.linsolver, max_num_steps=1_000_000)
-        if self.linsolver == "sparse":
+                    first_step=self.first_step, linsolver=self._ls, max_num_steps=1_000_000)
+        if self._ls == "sparse":
             opts.update(sparsity=self._filler.pattern, nthreads=1)
         else:
-            if self.linsolver == "band":   # node-interleaved: entry (i, j) of [q; v] goes to (p[i], p[j])
+            if self._ls == "band":   # node-interleaved: entry (i, j) of [q; v] goes to (p[i], p[j])
                 inv = np.empty(2 * n, dtype=np.int64)
                 inv[:n], inv[n:] = 2 * np.arange(n), 2 * np.arange(n) + 1
                 self._perm = np.argsort(inv)
@@ -205,7 +219,7 @@ class IDA(Integrator):
             cols = inv[np.repeat(np.arange(2 * n), np.diff(csc.indptr))]
             self._dense_index = rows * (2 * n) + cols
             self._buf = np.zeros(csc.nnz)
-            if self.linsolver == "band":
+            if self._ls == "band":
                 bw = int(np.max(np.abs(inv[P.row] - inv[P.col])))
                 opts.update(lband=bw, uband=bw)
         opts["atol"] = self._atol(q0, t_bound - t0)

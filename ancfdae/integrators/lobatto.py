@@ -6,7 +6,7 @@ convergence", i.e. Lobatto IIIA with s = 3 stages, with a modified Newton
 method on each step. s = 2 is the trapezoidal rule (order 2).
 
 The s-stage method is applied to ``q' = v, v' = a`` with ``r(t, q, v, a) = 0``
-(design.md Sect. 3) and the stage accelerations ``A_i`` as unknowns::
+(the Model contract's residual) and the stage accelerations ``A_i`` as unknowns::
 
     V_i = v_n + h sum_j a_ij A_j
     Q_i = q_n + c_i h v_n + h^2 sum_j (a^2)_ij A_j
@@ -53,6 +53,19 @@ class ButcherTableau:
     finite entries, the row-sum condition ``c_i = sum_j a_ij``, and the
     quadrature conditions ``sum_i b_i c_i^(k-1) = 1/k`` for ``k = 1..order``
     (necessary for the declared order).
+
+    Parameters
+    ----------
+    a : array_like, shape (s, s)
+        Runge-Kutta matrix.
+    b : array_like, shape (s,)
+        Weights.
+    c : array_like, shape (s,)
+        Nodes.
+    order : int
+        Declared order of the method.
+    name : str
+        Label used in messages.
     """
 
     a: np.ndarray
@@ -85,14 +98,17 @@ class ButcherTableau:
 
     @property
     def stages(self) -> int:
+        """Number of stages ``s``."""
         return self.a.shape[0]
 
     @property
     def explicit_first_stage(self) -> bool:
+        """True when the first row of ``a`` is zero."""
         return bool(np.all(self.a[0] == 0.0))
 
     @property
     def stiffly_accurate(self) -> bool:
+        """True when the last row of ``a`` equals ``b``."""
         return bool(np.array_equal(self.a[-1], self.b))
 
 
@@ -260,10 +276,12 @@ class LobattoIIIA(FixedStepIntegrator):
                     R[:, i] = self._residual(ts[i], Q[:, i], V_[:, i], X[:, i])
                 return R.ravel()
 
+            eigen = [self.newton.options.jacobian == "modified"]
+
             def jacobian(x):
                 X = x.reshape(n, m)
                 Q, V_ = Q0 + X @ CQ, V0 + X @ CV
-                if self.newton.options.jacobian == "modified":
+                if eigen[0]:
                     # Modified Newton reuses the matrix across steps anyway: one set of blocks (at
                     # the last stage) lets the stage system split in the tableau's eigenbasis.
                     blk = self._jacobian(ts[-1], Q[:, -1], V_[:, -1], X[:, -1])
@@ -278,7 +296,14 @@ class LobattoIIIA(FixedStepIntegrator):
                     self._set_floor(blk, Q[:, i])
                 return self._matrix(blocks, h)
 
-        out = self.newton.solve(residual, jacobian, self._guess(h).ravel())
+        guess = self._guess(h).ravel()
+        out = self.newton.solve(residual, jacobian, guess)
+        if not out.converged and m > 1 and eigen[0]:
+            # The one-state eigenbasis matrix can be too crude where the stages differ much (large
+            # steps, strong nonlinearity): before failing, retry the step with the exact per-stage matrix.
+            eigen[0] = False
+            self.newton.invalidate()
+            out = self.newton.solve(residual, jacobian, guess)
         if not out.converged:
             return False, f"Newton: {out.message}"
         X = out.x.reshape(n, m)

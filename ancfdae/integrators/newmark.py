@@ -2,7 +2,7 @@
 
 All three are one scheme, the generalized-alpha method of Chung and Hulbert
 (J. Appl. Mech. 60:371, 1993), written on the residual of the Model contract
-(design.md Sect. 3) with the unknown ``a_{n+1}``::
+(the Model contract's residual) with the unknown ``a_{n+1}``::
 
     q_{n+1} = q_n + h v_n + h^2 ((1/2 - beta) a_n + beta a_{n+1})
     v_{n+1} = v_n + h ((1 - gamma) a_n + gamma a_{n+1})
@@ -111,9 +111,15 @@ class HHTAlpha(_AlphaFamily):
 
     Parameters
     ----------
+    model : Model
+        The equations of motion.
+    h : float
+        Step size.
     alpha : float
         In [0, 1/3] (Hilber's parameter with the sign flipped); 0 is the
         trapezoidal rule, larger values damp high frequencies more.
+    newton : NewtonOptions or dict, optional
+        Newton options (default: modified Newton, tolerance 1e-8).
     """
 
     name = "hht"
@@ -134,9 +140,15 @@ class GeneralizedAlpha(_AlphaFamily):
 
     Parameters
     ----------
+    model : Model
+        The equations of motion.
+    h : float
+        Step size.
     rho_inf : float
         Spectral radius at infinite frequency, in [0, 1]; 1 = no dissipation
         (the trapezoidal rule), 0 = asymptotic annihilation.
+    newton : NewtonOptions or dict, optional
+        Newton options (default: modified Newton, tolerance 1e-8).
     """
 
     name = "generalized-alpha"

@@ -109,6 +109,13 @@ class Integrator(ABC):
     of their constructor (and ``h`` as the second when ``fixed_step``), and implement
     :meth:`step`. The base class keeps the current state (``t, q, v, a``) and the previous one,
     and provides :meth:`initialize`, :meth:`interpolate` and :meth:`restart`.
+
+    Parameters
+    ----------
+    model : Model
+        The equations of motion.
+    h : float, optional
+        Step size of a fixed-step method (None for adaptive ones).
     """
 
     name: str = "integrator"

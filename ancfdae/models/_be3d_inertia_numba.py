@@ -33,7 +33,11 @@ def spin_scratch(second):
     return np.zeros(7), np.zeros((7, 3)), np.zeros((7 if second else 1, 3, 3)), np.zeros(3), np.zeros((3, 3))
 
 
-@njit(cache=True)
+# Explicit signatures: one compilation each (constant flags would otherwise each get their own).
+_V3, _M33, _T333 = "float64[::1]", "float64[:, ::1]", "float64[:, :, ::1]"
+
+
+@njit(f"void({_V3}, {_V3}, {_V3}, {_M33}, {_T333}, boolean, {_V3}, {_M33}, {_T333}, {_V3}, {_M33})", cache=True)
 def _spin_vector(a, d, g, Gm, Hg, second, V, G, H, m, dm):
     """``g(a)``, ``G = dg/da`` and, if ``second``, ``Hg[i, j, k] = d2 g_i / da_j da_k`` at one point.
 
@@ -75,7 +79,7 @@ def _spin_vector(a, d, g, Gm, Hg, second, V, G, H, m, dm):
                     Hg[i, j, k] = H[_C, j, k] * m[i] + G[_C, j] * dm[i, k] + G[_C, k] * dm[i, j]
 
 
-@njit(cache=True, inline="always")
+@njit(f"void({_V3}, int64[:, ::1], {_V3}, {_V3}, float64)", cache=True)
 def _bat(out, dof, dN, x, scale):
     """``out += scale Ba^T x`` for a 3-vector ``x``."""
     for k in range(4):
@@ -83,7 +87,7 @@ def _bat(out, dof, dN, x, scale):
             out[dof[k, i]] += scale * dN[k] * x[i]
 
 
-@njit(cache=True, inline="always")
+@njit(f"void({_M33}, int64[:, ::1], {_V3}, {_M33}, float64)", cache=True)
 def _bat_m_ba(out, dof, dN, M, scale):
     """``out += scale Ba^T M Ba`` for a 3x3 ``M``."""
     for k in range(4):

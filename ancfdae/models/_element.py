@@ -50,6 +50,11 @@ class Element(ABC):
         False only for elements whose mass matrix depends on q (BE3D).
     formulations : tuple of str
         The formulation variants the element offers.
+    energy_degree : int or None
+        Degree of the strain energy as a polynomial in the element
+        coordinates, or None when it is not a polynomial (an energy-momentum
+        integrator integrates the gradient of a polynomial energy exactly
+        along the step with a Gauss rule).
     material : Material
         Instance attribute, required: the beam reads ``rho`` from it.
     section : RectangularSection or CircularSection
@@ -57,7 +62,7 @@ class Element(ABC):
 
     Notes
     -----
-    The attributes up to ``formulations`` are class attributes. Subclasses
+    The attributes up to ``energy_degree`` are class attributes. Subclasses
     keep every constructor option under its argument name, so that
     :meth:`Beam.describe` records it and a result file can rebuild the element.
     """
@@ -68,6 +73,7 @@ class Element(ABC):
     node_coordinates: ClassVar[tuple[str, ...]]
     mass_is_constant: ClassVar[bool] = True
     formulations: ClassVar[tuple[str, ...]] = ("structural",)
+    energy_degree: ClassVar[int | None] = None
 
     @property
     def n_nodes(self) -> int:

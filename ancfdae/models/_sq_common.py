@@ -80,6 +80,12 @@ class SQElement(Element):
         return (f"{self.name}(formulation={self.formulation!r}, nodes={self.nodes}, "
                 f"quadrature={self.quadrature!r}, kernel={self._kernel!r})")
 
+    @property
+    def energy_degree(self):
+        """4 for the continuum formulations (St. Venant-Kirchhoff energy of the Green strain, which is
+        quadratic in q, Eqs. 13, 28-33); None for the structural one (|r'| and the frame of Eq. 7)."""
+        return None if self.formulation == "structural" else 4
+
     # -- options ----------------------------------------------------------------------------
     def default_quadrature(self) -> dict:
         """Default rules, ``term -> (kind, n_points)``.
@@ -373,7 +379,8 @@ def _numba_geometry(formulation, dim, n_strain, geom):
             full_r[:, :, g["which"]] = g["ref"].reshape(n_el, P, -1)
             Dw.append(full_D)
             ref.append(full_r)
-        return N, dN, np.ascontiguousarray(np.concatenate(Dw, axis=1)), np.ascontiguousarray(np.concatenate(ref, axis=1))
+        return (N, dN, np.ascontiguousarray(np.concatenate(Dw, axis=1)),
+                np.ascontiguousarray(np.concatenate(ref, axis=1)))
     (g,) = groups
     Pc = g["Pc"]
     S, _, nb = Pc.shape

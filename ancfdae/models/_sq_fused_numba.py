@@ -2,6 +2,11 @@
 
 Gather, the element loop of :mod:`ancfdae.models._sq_numba` and the scatter into the beam's CSR
 data in one compiled call, for both formulations.
+
+numba's on-disk cache is keyed on this file only: the cached entry points hold a compiled copy of the
+SQ kernels they call, so after editing any SQ kernel module delete the ``*.nbi``/``*.nbc`` files in
+``ancfdae/models/__pycache__`` (measured: a stale cache kept running the previous SQ tangent, which
+``tests/test_fused_assembly.py`` caught as a fused/NumPy-assembly mismatch).
 """
 from __future__ import annotations
 

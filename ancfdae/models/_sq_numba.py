@@ -13,6 +13,13 @@ are allocated once per call, never per point.
 
 Importing this module imports numba; :mod:`ancfdae.models._sq_common` does so
 only when the compiled kernel is selected.
+
+numba's on-disk cache is keyed on the source file of the cached function
+only: after editing a function it calls from another file
+(:mod:`~ancfdae.models._vector_jet_numba`, :mod:`~ancfdae.models._sq_numba_structural`,
+:mod:`~ancfdae.models._sq_numba_continuum`), delete the ``*.nbi``/``*.nbc``
+files in ``ancfdae/models/__pycache__``, or the old code keeps running (the
+same holds for :mod:`~ancfdae.models._sq_numba_moment`).
 """
 from __future__ import annotations
 
@@ -132,9 +139,15 @@ def sq_structural(q, N, dN, Dw, ref, dim, order):
     v, g, H = np.empty(nv), np.zeros(nv), np.zeros((nv, nv))
     JV, JG, JH = np.zeros((N_JETS, 3)), np.zeros((N_JETS, 3, npv)), np.zeros((N_JETS, 3, npv, npv))
     eps, sig, Jm = np.empty(nk), np.empty(nk), np.zeros((nk, nv))
-    for e in range(n_el):
-        W[e] = _structural_element(dim, q[e], N[e], dN[e], Dw[e], ref[e], f[e], K[e if order >= 2 else 0], order,
-                                   Sb, col, v, g, H, JV, JG, JH, eps, sig, Jm)
+    # The dimension as a literal in each branch: the inlined gather and scatter loops over it unroll.
+    if dim == 3:
+        for e in range(n_el):
+            W[e] = _structural_element(3, q[e], N[e], dN[e], Dw[e], ref[e], f[e], K[e if order >= 2 else 0],
+                                       order, Sb, col, v, g, H, JV, JG, JH, eps, sig, Jm)
+    else:
+        for e in range(n_el):
+            W[e] = _structural_element(2, q[e], N[e], dN[e], Dw[e], ref[e], f[e], K[e if order >= 2 else 0],
+                                       order, Sb, col, v, g, H, JV, JG, JH, eps, sig, Jm)
     return W, f, K[:n_el if order >= 2 else 0]
 
 
@@ -178,8 +191,14 @@ def sq_continuum(q, N, dN, wax, blk, coef, cnt, ws, Ds, ref, vi, vj, dim, order)
     X, S = np.zeros((dim, dim)), np.zeros((dim, dim))
     eps, sig = np.empty(nvo), np.empty(nvo)
     Bm, DB, HX = np.zeros((nvo, ndd)), np.zeros((nvo, ndd)), np.zeros((ndd, ndd))
-    for e in range(n_el):
-        W[e] = _continuum_element(dim, q[e], N[e], dN[e], wax[e], blk, coef, cnt, ws, Ds, ref[e], vi, vj,
-                                  f[e], K[e if order >= 2 else 0], order, Sb, col, v, g, H, X, eps, sig, S, Bm,
-                                  DB, HX)
+    if dim == 3:
+        for e in range(n_el):
+            W[e] = _continuum_element(3, q[e], N[e], dN[e], wax[e], blk, coef, cnt, ws, Ds, ref[e], vi, vj,
+                                      f[e], K[e if order >= 2 else 0], order, Sb, col, v, g, H, X, eps, sig, S,
+                                      Bm, DB, HX)
+    else:
+        for e in range(n_el):
+            W[e] = _continuum_element(2, q[e], N[e], dN[e], wax[e], blk, coef, cnt, ws, Ds, ref[e], vi, vj,
+                                      f[e], K[e if order >= 2 else 0], order, Sb, col, v, g, H, X, eps, sig, S,
+                                      Bm, DB, HX)
     return W, f, K[:n_el if order >= 2 else 0]

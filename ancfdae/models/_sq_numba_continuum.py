@@ -19,7 +19,7 @@ __all__ = ["continuum_point"]
 _OPTS = dict(cache=True, fastmath={"contract"})
 
 
-@njit(**_OPTS)
+@njit(cache=True, inline="always", fastmath={"contract"})
 def continuum_point(dim, v, blk, coef, cnt, ws, Ds, ref, wax, vi, vj, X, eps, sig, S, Bm, DB, HX, g, H, order):
     """Energy at one axial point; gradient into ``g`` and Hessian into ``H`` (overwritten).
 

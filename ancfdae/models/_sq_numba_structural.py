@@ -95,7 +95,7 @@ def needs_frame(dim, Dw):
     return False
 
 
-@njit(**_OPTS)
+@njit(cache=True, inline="always", fastmath={"contract"})
 def structural_point(dim, v, Dw, ref, JV, JG, JH, eps, sig, Jm, g, H, order):
     """Energy density ``W`` at one point; its gradient into ``g`` and Hessian into ``H`` (overwritten).
 
@@ -159,7 +159,7 @@ def structural_point(dim, v, Dw, ref, JV, JG, JH, eps, sig, Jm, g, H, order):
         g[i] = s
     if order == 1:
         return W
-    # Gauss-Newton part Jm^T Dw Jm, over the strains that act here.
+    # Gauss-Newton part Jm^T Dw Jm over the strains that act here: upper triangle, then mirrored.
     H[:, :] = 0.0
     for k in range(nk):
         if Dw[k] == 0.0:
@@ -167,8 +167,11 @@ def structural_point(dim, v, Dw, ref, JV, JG, JH, eps, sig, Jm, g, H, order):
         for i in range(nv):
             x = Dw[k] * Jm[k, i]
             if x != 0.0:
-                for j in range(nv):
+                for j in range(i, nv):
                     H[i, j] += x * Jm[k, j]
+    for i in range(nv):
+        for j in range(i):
+            H[i, j] = H[j, i]
     # Second-derivative part sum_k sig_k d2 eps_k: c_kj is a jet in p, linear in d_j.
     for t in range(nt):
         k, off, c = terms[t, 0], npv + terms[t, 1] * dim, terms[t, 2]

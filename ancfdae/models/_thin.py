@@ -120,7 +120,7 @@ def clamp_coordinates(kind: str, frame: np.ndarray, extra: tuple[str, ...] = ())
     """Coordinates a support fixes: position for a pin; a clamp adds the transverse slopes.
 
     Fixing only the slope components perpendicular to the reference tangent
-    leaves the axial stretch at the clamp free (benchmarks.md B1); that is
+    leaves the axial stretch at the clamp free (fixing it too over-constrains the axial strain there); that is
     possible by fixing coordinates when the tangent is along a global axis.
     Otherwise all three slope coordinates are fixed, which also fixes the
     axial strain at the clamped node (a slightly stiffer support).

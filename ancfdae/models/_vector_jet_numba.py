@@ -7,7 +7,8 @@ Hessian ``h`` (d, K, K); a scalar is a jet with ``d = 1``. Jets are rows of
 three work arrays owned by the caller, ``V`` (n, 3), ``G`` (n, 3, K) and
 ``Hs`` (n, 3, K, K), and the functions take row numbers: no function
 allocates or creates an array view (each view costs reference counting),
-which at a few hundred flops per call would cost more than the arithmetic. ``order`` selects how much is propagated (0: value,
+which at a few hundred flops per call would cost more than the arithmetic.
+``order`` selects how much is propagated (0: value,
 1: plus gradient, 2: plus Hessian); entries above ``order`` are left as they
 are. Every rule is the plain product or chain rule, exact to rounding.
 """
@@ -77,8 +78,10 @@ def jcross(V, G, Hs, a, b, o, order):
         if order >= 2:
             for k in range(K):
                 for l in range(k, K):
-                    s = (Hs[a, i, k, l] * V[b, j] + V[a, i] * Hs[b, j, k, l] - Hs[a, j, k, l] * V[b, i] - V[a, j] * Hs[b, i, k, l]
-                         + G[a, i, k] * G[b, j, l] + G[a, i, l] * G[b, j, k] - G[a, j, k] * G[b, i, l] - G[a, j, l] * G[b, i, k])
+                    s = (Hs[a, i, k, l] * V[b, j] + V[a, i] * Hs[b, j, k, l]
+                         - Hs[a, j, k, l] * V[b, i] - V[a, j] * Hs[b, i, k, l]
+                         + G[a, i, k] * G[b, j, l] + G[a, i, l] * G[b, j, k]
+                         - G[a, j, k] * G[b, i, l] - G[a, j, l] * G[b, i, k])
                     Hs[o, c, k, l] = s
                     Hs[o, c, l, k] = s
 

@@ -116,7 +116,7 @@ class BE2D(Element):
         if kind == "pin":
             return ("x", "y")
         # Clamp: fix the transverse slope only, so the axial strain at the
-        # clamp stays free (benchmarks.md B1); possible when the axis is
+        # clamp stays free (fixing it too over-constrains the axial strain there); possible when the axis is
         # aligned with e_x or e_y, otherwise both slope coordinates are fixed.
         t = frame[:, 0]
         if abs(t[1]) < 1e-12:

@@ -1,6 +1,6 @@
 """Beam: mesh + element + supports + loads, assembled into a :class:`ancfdae.problem.Model`.
 
-The beam eliminates the fixed coordinates of its supports (design.md Sect. 3),
+The beam eliminates the fixed coordinates of its supports (every remaining coordinate is free),
 numbers the nodes along the axis (banded matrices) and assembles the element
 kernels of :mod:`ancfdae.models._element` into CSR matrices whose pattern is
 fixed at construction: K, D and M share one pattern, so an integrator forms
@@ -23,6 +23,7 @@ from . import _describe
 from ._assembly import Assembler
 from ._element import Element
 from ._mesh import mesh_from_points, straight_mesh
+from ._potential import PotentialMixin
 from ._quadrature import gauss
 
 __all__ = ["Beam"]
@@ -42,7 +43,7 @@ def _finish_stages():
     return finish_stages
 
 
-class Beam:
+class Beam(PotentialMixin):
     """A beam of ANCF elements with supports and loads: a Model.
 
     Parameters
@@ -83,6 +84,11 @@ class Beam:
     ----------
     n_dof : int
         Free coordinates.
+
+    Notes
+    -----
+    Also a :class:`ancfdae.problem.PotentialModel` (methods of
+    :class:`~ancfdae.models._potential.PotentialMixin`).
     load_factor : float
         Multiplies every external load (the static solver steps it).
     """
@@ -560,6 +566,8 @@ class Beam:
         caps = {"residual_jacobian", "residual_stages"}
         if not self.mass_is_constant:
             caps.add("variable_mass")
+        else:
+            caps.add("potential")       # M a + dP/dq - f_nc with a constant M (PotentialMixin)
         if self.element.event_state(self.geom):
             caps.add("step_events")
         return frozenset(caps)

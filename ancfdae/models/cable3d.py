@@ -114,7 +114,7 @@ class Cable3D(Element):
         """``"pin"``: r; ``"clamp"``: r and the slope components transverse to the reference tangent.
 
         With a tangent along a global axis the axial slope component stays
-        free (benchmarks.md B1); otherwise all slope coordinates are fixed.
+        free (fixing it over-constrains the axial strain); otherwise all slope coordinates are fixed.
         """
         return clamp_coordinates(kind, frame)
 

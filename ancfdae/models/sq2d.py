@@ -52,7 +52,7 @@ class SQ2D(SQElement):
         vectorised NumPy kernels of :mod:`ancfdae.models._sq_kernels`, the
         readable reference. ``"numba"``: one compiled loop over elements x
         points (:mod:`ancfdae.models._sq_numba`, same results to rounding; the
-        first use compiles, about a minute on a loaded 2-core machine, then
+        first use compiles, 1-3 minutes on a loaded 2-core machine, then
         loads from the on-disk cache in about a second). ``"auto"`` (default):
         numba when importable, else NumPy. Settable later through the
         ``kernel`` attribute; ``kernel_in_use`` says which one runs.
