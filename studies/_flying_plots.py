@@ -125,11 +125,17 @@ def plot_flying3d(records, path, chapter_failures=None) -> dict:
     main = [r for r in records if not r.get("long")]
     fig, axes = figure(1, 2, figsize=(13, 4.8))
     be_colors = {}
+    n_sq = 0
     for k, r in enumerate(main):
-        ls = "-" if r["element"] == "SQ3D" else "--"
-        line, = axes[0].plot(r["t"], r["energy"]["kinetic"] + r["energy"]["strain"], ls, lw=1, label=_label3d(r))
-        axes[1].semilogy(r["t"], np.abs(r["energy"]["balance"]) + 1e-16, ls, lw=1, color=line.get_color(),
-                         label=_label3d(r))
+        if r["element"] == "SQ3D":
+            # the SQ3D meshes coincide at this scale: thinner, differently dashed lines keep each visible
+            kw = dict(ls=("-", "--", ":", "-.")[n_sq % 4], lw=max(2.6 - 0.8 * n_sq, 0.8))
+            n_sq += 1
+        else:
+            kw = dict(ls="--", lw=1)
+        line, = axes[0].plot(r["t"], r["energy"]["kinetic"] + r["energy"]["strain"], label=_label3d(r), **kw)
+        axes[1].semilogy(r["t"], np.abs(r["energy"]["balance"]) + 1e-16, color=line.get_color(), label=_label3d(r),
+                         **kw)
         if r["element"] == "BE3D" and r["status"] != "success":
             axes[0].plot([r["t_end_reached"]], [r["energy"]["kinetic"][-1] + r["energy"]["strain"][-1]], "x",
                          color=line.get_color(), ms=9, mew=2)
