@@ -19,6 +19,7 @@ Imitates the simplified Newton of scipy's ``radau.solve_collocation_system``
 """
 from __future__ import annotations
 
+import math
 import numbers
 from dataclasses import dataclass, fields
 from typing import Callable
@@ -327,7 +328,7 @@ class NewtonSolver:
             r, J = self._eval_fused(fused, x0)
         else:
             r, J = self._eval(residual, x0), None
-        if not np.isfinite(max_abs(r)):
+        if not math.isfinite(max_abs(r)):
             self.stats.failed_solves += 1
             return NewtonOutcome(x0, False, 0, float("nan"), "residual at the initial guess is not finite")
         outcome = self._attempt(residual, jacobian, x0, r, fused, J)
@@ -375,7 +376,7 @@ class NewtonSolver:
             dx = self._lu.solve(r)   # the correction is -dx (negation commutes exactly with the solve)
             self.stats.iterations += 1
             dx_max = max_abs(dx)  # NaN/inf propagate into the max
-            if not np.isfinite(dx_max):
+            if not math.isfinite(dx_max):   # math: 20x cheaper than np on a float
                 return NewtonOutcome(x, False, k, err, "Newton correction is not finite "
                                      "(singular iteration matrix?)"), stale
             x = x - dx
@@ -384,7 +385,7 @@ class NewtonSolver:
             else:
                 r = self._eval(residual, x)
             err_new = max_abs(r)
-            if not np.isfinite(err_new):
+            if not math.isfinite(err_new):
                 return NewtonOutcome(x, False, k, float("nan"),
                                      f"residual became non-finite at iteration {k}"), stale
             if err_new <= threshold:
