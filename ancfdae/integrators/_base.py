@@ -14,6 +14,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ancfdae import _validate as V
+from ancfdae._scale import ROUNDOFF as SCALE_ROUNDOFF, force_scale
 from ancfdae.integrators._newton import NewtonOptions, NewtonSolver, NewtonStats
 from ancfdae.integrators.driver import GRID_TOL, check_model
 from ancfdae.integrators.protocol import Integrator, StepOutcome
@@ -35,7 +36,11 @@ class FixedStepIntegrator(Integrator):
     h : float
         Step size (> 0). The last step is shortened to end exactly at the end of the run.
     newton : NewtonOptions or dict, optional
-        Options of the Newton solver (dict: keyword arguments of :class:`NewtonOptions`).
+        Options of the Newton solver (dict: keyword arguments of :class:`NewtonOptions`). With
+        ``atol=None`` (the default) the absolute tolerance is derived from the problem at
+        :meth:`initialize`: ``ROUNDOFF * eps * force_scale(model, t0, q0, v0, a0)`` with
+        ``ROUNDOFF`` and ``force_scale`` of :mod:`ancfdae._scale` (stiffness times coordinates,
+        damping times velocities, inertia times accelerations, and the load).
 
     Notes
     -----
@@ -92,6 +97,13 @@ class FixedStepIntegrator(Integrator):
         self.newton.invalidate()
         self.newton.stats = NewtonStats()
         self.newton.residual_floor = 0.0
+        # A fixed atol in newtons is the whole load of a micro-fibre and below round-off for a
+        # 100 m beam: derive it from the problem's own force scale (the floor of _set_floor then
+        # follows the configuration as the Jacobian is re-evaluated).
+        self.newton.scaled_atol = 0.0
+        if self.newton.options.atol is None:
+            self.newton.scaled_atol = SCALE_ROUNDOFF * np.finfo(float).eps * force_scale(
+                self.model, self.t, self.q, self.v, self.a)
         self._init_impl()
 
     def _init_impl(self) -> None:

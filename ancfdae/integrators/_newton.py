@@ -19,6 +19,7 @@ Imitates the simplified Newton of scipy's ``radau.solve_collocation_system``
 """
 from __future__ import annotations
 
+import math
 import numbers
 from dataclasses import dataclass, fields
 from typing import Callable
@@ -57,15 +58,17 @@ class NewtonOptions:
         Relative tolerance: converged when ``max|r_k| <= tol * max|r_0|`` with
         ``r_0`` the residual at the initial guess of the solve (the chapter's
         criterion, Sects. 5.1-5.2, with ``tol = 1e-8``). In ``(0, 1)``.
-    atol : float
+    atol : float or None
         Absolute floor, in the residual's own units (forces, for the models of
         this package): also converged when ``max|r_k| <= atol``. It settles
         solves whose initial residual is already negligible (relative
-        reduction of a round-off-sized residual is impossible). The default
-        ``1e-10`` is the default absolute tolerance of Exudyn's Newton solver;
-        it is far below any force that matters in the chapter's problems.
-        Integrators raise it to the round-off level of the model when they
-        know it. ``>= 0``.
+        reduction of a round-off-sized residual is impossible). ``None`` (the
+        default) derives it from the problem: the integrators set
+        :attr:`NewtonSolver.scaled_atol` to ``ROUNDOFF * eps * force_scale``
+        of the initial state (:mod:`ancfdae._scale`), so a 1 um fibre and a
+        100 m beam get floors of their own size; a solver nobody scales uses
+        ``0`` (the relative test and the round-off floors alone). A number is
+        used as given. ``>= 0``.
     max_iter : int
         Iterations allowed per attempt (per retry as well). ``>= 1``.
     jacobian : {"modified", "full"}
@@ -86,7 +89,7 @@ class NewtonOptions:
     """
 
     tol: float = 1e-8
-    atol: float = 1e-10
+    atol: float | None = None
     max_iter: int = 25
     jacobian: str = "modified"
     contraction: float = 0.3
@@ -95,7 +98,8 @@ class NewtonOptions:
 
     def __post_init__(self):
         _real("tol", self.tol, low=0.0, high=1.0, low_open=True, high_open=True)
-        _real("atol", self.atol, low=0.0)
+        if self.atol is not None:
+            _real("atol", self.atol, low=0.0)
         if isinstance(self.max_iter, bool) or not isinstance(self.max_iter, numbers.Integral) or self.max_iter < 1:
             raise ValueError(f"`max_iter` must be a positive integer, got {self.max_iter!r}.")
         if self.jacobian not in ("modified", "full"):
@@ -209,10 +213,14 @@ class NewtonSolver:
     stats : NewtonStats
         Cumulative counters over every call.
 
+    scaled_atol : float
+        The absolute tolerance used when ``options.atol`` is ``None``, set by
+        the caller from the problem's force scale (``0`` until it does).
     residual_floor : float
         Absolute round-off floor of the residual that the caller may set (and
         update, e.g. at every Jacobian evaluation): the convergence test is
-        ``max|r_k| <= max(tol * max|r_0|, atol, residual_floor)``. The
+        ``max|r_k| <= max(tol * max|r_0|, atol, residual_floor)`` (``atol`` the
+        property below). The
         integrators set it to ``ROUNDOFF * eps * max|K| * max(1, max|q|)``:
         a residual of elastic forces cannot be computed more accurately than
         that (measured: 4e-7 N on Exudyn's 25-element BE2D pendulum, where
@@ -233,8 +241,15 @@ class NewtonSolver:
             raise TypeError(f"`options` must be a NewtonOptions, got {type(options).__name__}.")
         self.options = options
         self.stats = NewtonStats()
+        self.scaled_atol = 0.0
         self.residual_floor = 0.0
         self._lu: _Factor | None = None
+
+    @property
+    def atol(self) -> float:
+        """The absolute tolerance in force: ``options.atol``, or :attr:`scaled_atol` when that is ``None``."""
+        a = self.options.atol
+        return self.scaled_atol if a is None else a
 
     def invalidate(self) -> None:
         """Drop the cached factorisation; the next iteration refactorises."""
@@ -313,7 +328,7 @@ class NewtonSolver:
             r, J = self._eval_fused(fused, x0)
         else:
             r, J = self._eval(residual, x0), None
-        if not np.isfinite(max_abs(r)):
+        if not math.isfinite(max_abs(r)):
             self.stats.failed_solves += 1
             return NewtonOutcome(x0, False, 0, float("nan"), "residual at the initial guess is not finite")
         outcome = self._attempt(residual, jacobian, x0, r, fused, J)
@@ -345,7 +360,7 @@ class NewtonSolver:
         stale = self._lu is not None and not full
         x = x0.copy()
         err0 = err = max_abs(r)
-        rel = max(opts.tol * err0, opts.atol)
+        rel = max(opts.tol * err0, self.atol)
         threshold = max(rel, self.residual_floor)
         if err <= threshold:
             return NewtonOutcome(x, True, 0, err, "converged at the initial guess"), stale
@@ -361,7 +376,7 @@ class NewtonSolver:
             dx = self._lu.solve(r)   # the correction is -dx (negation commutes exactly with the solve)
             self.stats.iterations += 1
             dx_max = max_abs(dx)  # NaN/inf propagate into the max
-            if not np.isfinite(dx_max):
+            if not math.isfinite(dx_max):   # math: 20x cheaper than np on a float
                 return NewtonOutcome(x, False, k, err, "Newton correction is not finite "
                                      "(singular iteration matrix?)"), stale
             x = x - dx
@@ -370,7 +385,7 @@ class NewtonSolver:
             else:
                 r = self._eval(residual, x)
             err_new = max_abs(r)
-            if not np.isfinite(err_new):
+            if not math.isfinite(err_new):
                 return NewtonOutcome(x, False, k, float("nan"),
                                      f"residual became non-finite at iteration {k}"), stale
             if err_new <= threshold:

@@ -37,6 +37,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ancfdae import _validate as V
+from ancfdae.integrators._affine import affine2, stage_states
 from ancfdae.integrators._base import FixedStepIntegrator
 from ancfdae.integrators._linsolve import StageMatrix
 from ancfdae.integrators.protocol import Quadrature
@@ -255,19 +256,18 @@ class LobattoIIIA(FixedStepIntegrator):
             v0, q0, cv, cq, t1 = V0[:, 0], Q0[:, 0], CV[0, 0], CQ[0, 0], ts[0]
 
             def residual(x):
-                return self._residual(t1, q0 + cq * x, v0 + cv * x, x)
+                return self._residual(t1, *affine2(q0, v0, cq, cv, x), x)
 
             def jacobian(x):
-                qs = q0 + cq * x
-                blk = self._jacobian(t1, qs, v0 + cv * x, x)
+                qs, vs = affine2(q0, v0, cq, cv, x)
+                blk = self._jacobian(t1, qs, vs, x)
                 self._set_floor(blk, qs)
                 return self._matrix([blk], h)
         else:
             stages = self.model.residual_stages if self._stages else None
 
             def residual(x):
-                X = x.reshape(n, m)
-                Q, V_ = Q0 + X @ CQ, V0 + X @ CV
+                Q, V_, X = stage_states(Q0, V0, CQ, CV, x)   # one compiled call for both products
                 if stages is not None:   # all stages in one model call (optional Model method)
                     self._n_res += m
                     return stages(ts, Q, V_, X).ravel()
@@ -279,8 +279,7 @@ class LobattoIIIA(FixedStepIntegrator):
             eigen = [self.newton.options.jacobian == "modified"]
 
             def jacobian(x):
-                X = x.reshape(n, m)
-                Q, V_ = Q0 + X @ CQ, V0 + X @ CV
+                Q, V_, X = stage_states(Q0, V0, CQ, CV, x)
                 if eigen[0]:
                     # Modified Newton reuses the matrix across steps anyway: one set of blocks (at
                     # the last stage) lets the stage system split in the tableau's eigenbasis.
@@ -306,8 +305,7 @@ class LobattoIIIA(FixedStepIntegrator):
             out = self.newton.solve(residual, jacobian, guess)
         if not out.converged:
             return False, f"Newton: {out.message}"
-        X = out.x.reshape(n, m)
-        Q, V_ = Q0 + X @ CQ, V0 + X @ CV
+        Q, V_, X = stage_states(Q0, V0, CQ, CV, out.x)
         if self.predictor == "extrapolate":
             self._prev = (h, np.column_stack([self.a, X]))
         quad = None
