@@ -1,7 +1,7 @@
 """Compiled affine state updates of the fixed-step integrators against their NumPy expressions."""
 import numpy as np
 
-from ancfdae.integrators._affine import affine2, affine3, newmark_predict, stage_states
+from ancfdae.integrators._affine import affine2, affine3, newmark_predict, stage_constants, stage_states
 
 
 def test_newmark_updates_are_bit_for_bit_numpy():
@@ -36,3 +36,13 @@ def test_stage_states_match_numpy_to_roundoff():
     assert np.array_equal(X, Xr)
     np.testing.assert_allclose(Q, Q0 + Xr @ CQ, rtol=0, atol=4 * np.finfo(float).eps * 10)
     np.testing.assert_allclose(V, V0 + Xr @ CV, rtol=0, atol=4 * np.finfo(float).eps * 10)
+
+
+def test_stage_constants_are_bit_for_bit_numpy():
+    # Catches the stage coefficients applied to the wrong vector (c to a, a_first to v) or per row.
+    rng = np.random.default_rng(5)
+    q, v, a = (rng.standard_normal(19) for _ in range(3))
+    ca, cc, ca2 = (rng.standard_normal(2) for _ in range(3))
+    Q0, V0 = stage_constants(q, v, a, ca, cc, ca2)
+    assert np.array_equal(V0, v[:, None] + ca * a[:, None])
+    assert np.array_equal(Q0, q[:, None] + cc * v[:, None] + ca2 * a[:, None])

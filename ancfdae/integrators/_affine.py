@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["affine2", "affine3", "newmark_predict", "stage_states"]
+__all__ = ["affine2", "affine3", "newmark_predict", "stage_constants", "stage_states"]
 
 
 @njit(cache=True)
@@ -80,3 +80,16 @@ def affine2(q0, v0, cq, cv, x):
         q[i] = q0[i] + cq * x[i]
         v[i] = v0[i] + cv * x[i]
     return q, v
+
+
+@njit(cache=True)
+def stage_constants(q, v, a, ca, cc, ca2):
+    """The constant parts of Lobatto's stage states, ``V0 = v + a ca^T`` and
+    ``Q0 = q + v cc^T + a ca2^T`` as (n, m) arrays (bit-for-bit the NumPy broadcasts)."""
+    n, m = q.shape[0], ca.shape[0]
+    Q0, V0 = np.empty((n, m)), np.empty((n, m))
+    for i in range(n):
+        for j in range(m):
+            V0[i, j] = v[i] + ca[j] * a[i]
+            Q0[i, j] = q[i] + cc[j] * v[i] + ca2[j] * a[i]
+    return Q0, V0

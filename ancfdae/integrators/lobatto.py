@@ -37,7 +37,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ancfdae import _validate as V
-from ancfdae.integrators._affine import affine2, stage_states
+from ancfdae.integrators._affine import affine2, stage_constants, stage_states
 from ancfdae.integrators._base import FixedStepIntegrator
 from ancfdae.integrators._linsolve import StageMatrix
 from ancfdae.integrators.protocol import Quadrature
@@ -249,8 +249,7 @@ class LobattoIIIA(FixedStepIntegrator):
         m, n = self._m, self.n_dof
         ts = t + self._c * h
         # Stage states are affine in X: V = V0 + X @ CV, Q = Q0 + X @ CQ (constant parts once per step).
-        V0 = self.v[:, None] + (h * self._a_first) * self.a[:, None]
-        Q0 = self.q[:, None] + (h * self._c) * self.v[:, None] + (h * h * self._a2_first) * self.a[:, None]
+        Q0, V0 = stage_constants(self.q, self.v, self.a, h * self._a_first, h * self._c, h * h * self._a2_first)
         CV, CQ = (h * self._a_rest).T, (h * h * self._a2_rest).T
         if m == 1:
             v0, q0, cv, cq, t1 = V0[:, 0], Q0[:, 0], CV[0, 0], CQ[0, 0], ts[0]
