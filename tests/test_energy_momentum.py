@@ -119,7 +119,7 @@ def test_free_motion_energy_constant_over_ten_thousand_steps():
     """B2 with one BE2D element after the pulse, 10^4 steps: energy constant to 1e-12 relative.
 
     The only 10^4-step case of the suite: one such run of the energy-momentum method costs about 10 ms per
-    step in Python (104 s wall for BE2D with 1 element on the shared 2-core machine, 185 s for BE2D
+    step in Python (104 s wall for BE2D with 1 element on the shared 2-core machine, 186 s for BE2D
     continuum), so a second one would exceed the suite's time budget. The other constant-mass elements run
     250 free steps in :func:`test_free_motion_energy_constant_every_element`; their 10^4-step drift is
     measured by ``python -m benchmarks.energy_momentum --case long --elements 1``.
