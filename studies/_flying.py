@@ -128,7 +128,8 @@ def simulate_case(beam, t_end: float, method: str = "lobatto3", h: float | None 
         ``h`` keeps the samples on the step grid, without interpolation).
     newton : dict, optional
         :class:`NewtonOptions` fields; default modified Newton, tol 1e-8
-        (chapter Sect. 5.2).
+        (chapter Sect. 5.2). The energy-momentum method keeps its own default
+        (round-off tolerance: what makes it conserve energy) unless ``newton`` is given.
     energy : bool
         Log the energy balance (costs a few external-power evaluations per step).
     stop_on_blowup : bool
@@ -146,7 +147,7 @@ def simulate_case(beam, t_end: float, method: str = "lobatto3", h: float | None 
     monitors = [PointSensor(s=0.0, name="tip")]
     if energy:
         monitors.append(EnergyMonitor(stop_on_blowup=stop_on_blowup))
-    if method != "ida":
+    if method != "ida" and not (method == "energy-momentum" and newton is None):
         options["newton"] = NewtonOptions(**({"tol": 1e-8, "jacobian": "modified"} | (newton or {})))
     c0, w0 = time.process_time(), time.perf_counter()
     res = simulate(beam, (0.0, t_end), method=method, h=h, t_eval=t_eval, monitors=monitors, **options)

@@ -111,6 +111,7 @@ def plot_flying2d(rows, refs, orders, fits, path) -> dict:
 
 def _label3d(r):
     lab = f"{r['element']} {r['n']} el" + (f" ({r['director_update']})" if r["element"] == "BE3D" else "")
+    lab += f", {r['method']}" if r.get("method", "lobatto3") != "lobatto3" else ""
     lab += f", h {r['h']:g}"
     return lab + ("" if r["status"] == "success" else f", fails {r['t_end_reached']:.2f} s")
 

@@ -11,8 +11,9 @@ def quick(tmp_path_factory):
     return flying3d.run(quick=True, out=out, jobs=2, progress=False)
 
 
-def _rows(quick, element):
-    return sorted((r for r in quick["rows"] if r["element"] == element), key=lambda r: -r["h"])
+def _rows(quick, element, method="lobatto3"):
+    return sorted((r for r in quick["rows"] if r["element"] == element and r["method"] == method),
+                  key=lambda r: -r["h"])
 
 
 def test_sq3d_energy_balance_holds_after_the_load_to_the_integrators_accuracy(quick):
@@ -31,6 +32,20 @@ def test_sq3d_energy_balance_holds_after_the_load_to_the_integrators_accuracy(qu
     assert 3.0 < p_free < 5.5
 
 
+def test_sq3d_energy_momentum_balance_exact_after_the_load(quick):
+    """SQ3D with the energy-momentum method (constant mass): after the load the balance stays at round-off.
+
+    Catches: the study running it with the Lobatto IIIA Newton tolerance 1e-8 (drift ~1e-9 J), or not at all.
+    """
+    (em,) = _rows(quick, "SQ3D", "energy-momentum")
+    (lob,) = [r for r in _rows(quick, "SQ3D") if r["h"] == em["h"]]
+    assert (em["n"], em["h"], em["status"]) == (2, 4e-3, "success")
+    energy = em["energy_at_load_end"]
+    assert energy == pytest.approx(lob["energy_at_load_end"], rel=1e-3)
+    assert em["drift_max"] < 1e-12 * energy
+    assert em["drift_max"] < 1e-2 * lob["drift_max"]
+
+
 def test_be3d_energy_error_is_the_director_update(quick):
     (be,) = _rows(quick, "BE3D")
     (sq,) = [r for r in _rows(quick, "SQ3D") if r["h"] == be["h"]]
@@ -46,12 +61,13 @@ def test_be3d_energy_error_is_the_director_update(quick):
 
 def test_quick_mode_writes_table_and_figures(quick):
     md = (quick["path"] / "flying3d.md").read_text()
-    assert md.count("| SQ3D |") == 2 and md.count("| BE3D |") == 1
+    assert md.count("| SQ3D |") == 3 and md.count("| BE3D |") == 1 and md.count("| energy-momentum |") == 1
     for stem in ("fig11_energy", "fig12_displacement"):
         assert (quick["path"] / f"{stem}.png").is_file() and (quick["path"] / f"{stem}.svg").is_file()
     energy_ax = quick["figures"]["fig11_energy"].axes[0]
     labels = [ln.get_label() for ln in energy_ax.get_lines()]
-    assert sum(lab.startswith("SQ3D 2 el") for lab in labels) == 2
+    assert sum(lab.startswith("SQ3D 2 el") for lab in labels) == 3
+    assert sum("energy-momentum" in lab for lab in labels) == 1
     assert sum(lab.startswith("BE3D") for lab in labels) == 1
     # the displacement figure: one column per type, u_x, u_y, u_z rows
     assert len(quick["figures"]["fig12_displacement"].axes) == 6
