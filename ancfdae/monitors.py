@@ -130,7 +130,7 @@ class EnergyMonitor(Monitor):
     Internal damping is not a load: a damped model loses ``E``.
     """
 
-    def __init__(self, name: str = "energy", blowup: float = 0.1, stop_on_blowup: bool = False):
+    def __init__(self, name: str = "energy", blowup: float = 0.1, stop_on_blowup: bool = False) -> None:
         self.name = str(name)
         self.blowup = V.positive("blowup", blowup)
         if not isinstance(stop_on_blowup, bool):
@@ -217,7 +217,7 @@ class PointSensor(Monitor):
     """
 
     def __init__(self, s: float | None = None, *, function: Callable | None = None, name: str | None = None,
-                 velocity_function: Callable | None = None):
+                 velocity_function: Callable | None = None) -> None:
         if (s is None) == (function is None):
             raise ValueError("PointSensor needs exactly one of `s` (arc length) or `function`, "
                              f"got s={s!r}, function={function!r}.")
@@ -267,7 +267,7 @@ class Probe(Monitor):
         ``function(t, q, v, a) -> array``, logged as ``"value"``.
     """
 
-    def __init__(self, name: str, function: Callable):
+    def __init__(self, name: str, function: Callable) -> None:
         if not callable(function):
             raise ValueError(f"`function` must be callable, got {function!r}.")
         self.name, self.function = str(name), function

@@ -160,7 +160,7 @@ CAPABILITIES: dict[str, tuple[str, ...]] = {
 }
 
 
-def capabilities(model) -> frozenset:
+def capabilities(model: object) -> frozenset:
     """The optional capabilities ``model`` declares, checked; empty when it declares none.
 
     The declaration is looked up without ``__getattr__`` (:func:`inspect.getattr_static`), so a
@@ -223,15 +223,17 @@ class PotentialModel(Protocol):
         """``P(q) = U(q) + V(q)`` (equal to ``energy(t, q, v).strain + .potential``)."""
         ...
 
-    def potential_gradient(self, t: float, q: np.ndarray, tangent: bool = True):
+    def potential_gradient(self, t: float, q: np.ndarray,
+                           tangent: bool = True) -> tuple[np.ndarray, sp.spmatrix | None]:
         """``(dP/dq, d2P/dq2 as a sparse matrix or None)``."""
         ...
 
-    def nonconservative_force(self, t: float, q: np.ndarray, tangent: bool = True):
+    def nonconservative_force(self, t: float, q: np.ndarray,
+                             tangent: bool = True) -> tuple[np.ndarray, sp.spmatrix | None]:
         """``(f_nc(t, q), df_nc/dq as a sparse matrix or None)``; ``external_power = f_nc . v``."""
         ...
 
-    def symmetry_generators(self):
+    def symmetry_generators(self) -> tuple[np.ndarray, list[sp.spmatrix]]:
         """Rigid motions that leave the strain energy unchanged: ``(T, A)``.
 
         ``T`` (n_dof, k_t): constant translation directions; ``A``: list of

@@ -10,14 +10,21 @@ TypeError naming the argument). The run itself is the one driver loop of
 from __future__ import annotations
 
 import inspect
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from numpy.typing import ArrayLike
 
 from ancfdae.integrators.driver import integrate
 from ancfdae.integrators.energy_momentum import EnergyMomentum
+from ancfdae.integrators._newton import NewtonOptions
 from ancfdae.integrators.ida import IDA
 from ancfdae.integrators.lobatto import LobattoIIIA
 from ancfdae.integrators.newmark import GeneralizedAlpha, HHTAlpha, Newmark
 from ancfdae._resultfile import describe_model
 from ancfdae.integrators.protocol import Integrator
+from ancfdae.monitors import Monitor
+from ancfdae.problem import Model
 from ancfdae.result import Result
 
 __all__ = ["simulate", "METHODS"]
@@ -28,7 +35,8 @@ class Lobatto3(LobattoIIIA):
 
     name = "lobatto3"
 
-    def __init__(self, model, h, *, newton=None, predictor="constant"):
+    def __init__(self, model: Model, h: float, *, newton: NewtonOptions | dict | None = None,
+                 predictor: str = "constant") -> None:
         super().__init__(model, h, 3, newton=newton, predictor=predictor)
 
 
@@ -37,7 +45,8 @@ class Lobatto2(LobattoIIIA):
 
     name = "lobatto2"
 
-    def __init__(self, model, h, *, newton=None, predictor="constant"):
+    def __init__(self, model: Model, h: float, *, newton: NewtonOptions | dict | None = None,
+                 predictor: str = "constant") -> None:
         super().__init__(model, h, 2, newton=newton, predictor=predictor)
 
 
@@ -92,8 +101,11 @@ def _build(model, method, h, options):
         raise type(exc)(f"method {label!r}: {exc}") from exc
 
 
-def simulate(model, t_span, method="lobatto3", h=None, t_eval=None, monitors=(), hooks=(), q0=None, v0=None,
-             state0=None, max_steps=None, progress=False, **options) -> Result:
+def simulate(model: Model, t_span: tuple[float, float], method: str | type[Integrator] | Integrator = "lobatto3",
+             h: float | None = None, t_eval: ArrayLike | None = None, monitors: Sequence[Monitor] = (),
+             hooks: Sequence[Callable] = (), q0: ArrayLike | None = None, v0: ArrayLike | None = None,
+             state0: dict | None = None, max_steps: int | None = None, progress: bool = False,
+             **options: Any) -> Result:
     """Integrate ``model`` over ``t_span`` with the named integrator.
 
     Parameters

@@ -6,12 +6,13 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.linalg import LinAlgWarning
 
 from ._validate import positive_int
 from .integrators._newton import NewtonOptions, NewtonSolver, NewtonStats
 from ._scale import ROUNDOFF, force_scale
-from .problem import capabilities
+from .problem import Model, capabilities
 
 __all__ = ["solve_static", "StaticResult"]
 
@@ -55,7 +56,7 @@ class StaticResult:
         return self.status == "converged"
 
 
-def solve_static(model, load_steps: int = 10, *, t: float = 0.0, q0=None, tol: float = 1e-8,
+def solve_static(model: Model, load_steps: int = 10, *, t: float = 0.0, q0: ArrayLike | None = None, tol: float = 1e-8,
                  atol: float | None = None, max_iter: int = 25, jacobian: str = "full") -> StaticResult:
     """Solve ``r(t, q, 0, 0) = 0`` with the loads applied in uniform steps.
 

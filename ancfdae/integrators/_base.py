@@ -12,12 +12,14 @@ from abc import abstractmethod
 
 import numpy as np
 import scipy.sparse as sp
+from numpy.typing import ArrayLike
 
 from ancfdae import _validate as V
 from ancfdae._scale import ROUNDOFF as SCALE_ROUNDOFF, force_scale
 from ancfdae.integrators._newton import NewtonOptions, NewtonSolver, NewtonStats
 from ancfdae.integrators.driver import GRID_TOL, check_model
 from ancfdae.integrators.protocol import Integrator, StepOutcome
+from ancfdae.problem import Model
 
 __all__ = ["FixedStepIntegrator"]
 
@@ -52,7 +54,7 @@ class FixedStepIntegrator(Integrator):
     order = 0
     fixed_step = True
 
-    def __init__(self, model, h, *, newton=None):
+    def __init__(self, model: Model, h: float, *, newton: NewtonOptions | dict | None = None) -> None:
         self.n_dof = check_model(model)
         super().__init__(model, V.positive("h", h))
         if newton is None:
@@ -88,7 +90,7 @@ class FixedStepIntegrator(Integrator):
         self.newton.residual_floor = max(self.newton.residual_floor, floor)
 
     # -- protocol ------------------------------------------------------------------------------
-    def initialize(self, t0, q0, v0, a0, t_bound) -> None:
+    def initialize(self, t0: float, q0: ArrayLike, v0: ArrayLike, a0: ArrayLike, t_bound: float) -> None:
         """Take the initial state; reset the grid, the Newton solver and the counters."""
         super().initialize(t0, np.array(q0, dtype=float), np.array(v0, dtype=float),
                            np.array(a0, dtype=float), t_bound)
@@ -128,7 +130,7 @@ class FixedStepIntegrator(Integrator):
         super().accept(outcome)
         self.n_steps += 1
 
-    def restart(self, t, q, v, a, model=None) -> None:
+    def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model | None = None) -> None:
         """Carry on from a state changed by a model event (grid and Newton matrix kept)."""
         prev = self.previous
         super().restart(t, q, v, a, model)

@@ -25,6 +25,7 @@ from dataclasses import dataclass, fields
 from typing import Callable
 
 import numpy as np
+from numpy.typing import ArrayLike
 from numba import njit
 
 from ._linsolve import factorize
@@ -234,7 +235,7 @@ class NewtonSolver:
     iteration-matrix coefficients, different equations).
     """
 
-    def __init__(self, options: NewtonOptions | None = None):
+    def __init__(self, options: NewtonOptions | None = None) -> None:
         if options is None:
             options = NewtonOptions()
         if not isinstance(options, NewtonOptions):
@@ -294,7 +295,7 @@ class NewtonSolver:
         self,
         residual: Callable[[np.ndarray], np.ndarray],
         jacobian: Callable[[np.ndarray], object],
-        x0,
+        x0: ArrayLike,
         residual_jacobian: Callable[[np.ndarray], tuple] | None = None,
     ) -> NewtonOutcome:
         """Iterate from ``x0`` until the residual test passes.

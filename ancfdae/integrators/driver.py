@@ -16,14 +16,22 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from numpy.typing import ArrayLike
 
 from ancfdae import _validate as V
 from ancfdae.integrators._recorder import Recorder
-from ancfdae.problem import capabilities
+from ancfdae.problem import Model, capabilities
+
+if TYPE_CHECKING:                       # these modules import the driver
+    from ancfdae.integrators.protocol import Integrator
+    from ancfdae.monitors import Monitor
+    from ancfdae.result import Result
 
 __all__ = ["check_model", "consistent_acceleration", "output_times", "integrate", "GRID_TOL",
            "DEFAULT_MAX_STEPS"]
@@ -35,7 +43,7 @@ GRID_TOL = 1e-9
 DEFAULT_MAX_STEPS = 10_000_000
 
 
-def check_model(model) -> int:
+def check_model(model: Model) -> int:
     """Check that ``model`` offers the Model contract and valid capabilities; return ``n_dof``."""
     missing = [m for m in _CONTRACT if not callable(getattr(model, m, None))]
     if missing:
@@ -48,7 +56,8 @@ def check_model(model) -> int:
     return int(n)
 
 
-def consistent_acceleration(model, t, q, v):
+def consistent_acceleration(model: Model, t: float, q: np.ndarray,
+                            v: np.ndarray) -> tuple[np.ndarray, None] | tuple[None, str]:
     """Solve ``M(q) a = -r(t, q, v, 0)``; return ``(a, None)`` or ``(None, reason)``."""
     rhs = -np.asarray(model.residual(t, q, v, np.zeros_like(q)), dtype=float)
     M = model.mass(q)
@@ -64,7 +73,8 @@ def consistent_acceleration(model, t, q, v):
     return a, None
 
 
-def output_times(t_span, t_eval):
+def output_times(t_span: tuple[float, float],
+                 t_eval: ArrayLike | None) -> tuple[float, float, np.ndarray | None]:
     """Validate ``t_span = (t0, tf)`` and ``t_eval``; return ``(t0, tf, t_out or None)``."""
     try:
         t0, tf = (float(x) for x in t_span)
@@ -148,8 +158,10 @@ class _Progress:
             self.bar.close()
 
 
-def integrate(stepper, model, t_span, t_eval=None, monitors=(), hooks=(), q0=None, v0=None, state0=None,
-              max_steps=None, progress=False):
+def integrate(stepper: Integrator, model: Model, t_span: tuple[float, float], t_eval: ArrayLike | None = None,
+              monitors: Sequence[Monitor] = (), hooks: Sequence[Callable] = (), q0: ArrayLike | None = None,
+              v0: ArrayLike | None = None, state0: dict | None = None, max_steps: int | None = None,
+              progress: bool = False) -> Result:
     """Run ``stepper`` (an :class:`~.protocol.Integrator`) on ``model`` over ``t_span``.
 
     Parameters

@@ -83,7 +83,7 @@ from ancfdae.integrators._base import FixedStepIntegrator
 from ancfdae.integrators._discrete_gradient import AVFGradient, GonzalezGradient
 from ancfdae.integrators._newton import NewtonOptions
 from ancfdae.integrators.protocol import Quadrature
-from ancfdae.problem import capabilities
+from ancfdae.problem import Model, capabilities
 
 __all__ = ["EnergyMomentum", "DISCRETE_GRADIENTS", "DEFAULT_NEWTON"]
 
@@ -129,7 +129,8 @@ class EnergyMomentum(FixedStepIntegrator):
     order = 2
     fixed_step = True
 
-    def __init__(self, model, h, *, discrete_gradient="auto", angular_momentum=True, newton=None):
+    def __init__(self, model: Model, h: float, *, discrete_gradient: str = "auto", angular_momentum: bool = True,
+                 newton: NewtonOptions | dict | None = None) -> None:
         if not getattr(model, "mass_is_constant", False):
             raise ValueError("`model` must have a constant mass matrix for method 'energy-momentum' "
                              f"(mass_is_constant=True), got {type(model).__name__} with mass_is_constant=False "
@@ -173,7 +174,7 @@ class EnergyMomentum(FixedStepIntegrator):
         self._dg.evals = 0
         self._check_split(self.t, self.q, self.v)
 
-    def restart(self, t, q, v, a, model=None):
+    def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model | None = None) -> None:
         """Carry on from a state a model event changed (grid and Newton matrix kept)."""
         super().restart(t, q, v, a, model)
         if self.model is not self._model_bound:

@@ -24,11 +24,13 @@ import warnings
 
 import numpy as np
 import scipy.sparse as sp
+from numpy.typing import ArrayLike
 
 from ancfdae import _validate as V
 from ancfdae.integrators._ida_jacobian import _JacobianFiller
 from ancfdae.integrators.driver import check_model
 from ancfdae.integrators.protocol import Integrator, StepOutcome
+from ancfdae.problem import Model
 
 __all__ = ["IDA"]
 
@@ -120,8 +122,9 @@ class IDA(Integrator):
     fixed_step = False
     consistent_restart = True
 
-    def __init__(self, model, rtol=1e-6, atol=None, *, max_order=5, max_step=0.0, first_step=0.0,
-                 linsolver="auto"):
+    def __init__(self, model: Model, rtol: float = 1e-6, atol: float | ArrayLike | None = None, *,
+                 max_order: int = 5, max_step: float = 0.0, first_step: float = 0.0,
+                 linsolver: str = "auto") -> None:
         self.n_dof = check_model(model)
         super().__init__(model, None)
         self.rtol = V.positive("rtol", rtol)
@@ -193,7 +196,7 @@ class IDA(Integrator):
         return (y, yp) if self._perm is None else (y[self._perm], yp[self._perm])
 
     # -- protocol -----------------------------------------------------------------------------
-    def initialize(self, t0, q0, v0, a0, t_bound) -> None:
+    def initialize(self, t0: float, q0: ArrayLike, v0: ArrayLike, a0: ArrayLike, t_bound: float) -> None:
         """Set up the solver (pattern of the Jacobian at t0) and take the initial state."""
         super().initialize(t0, q0, v0, a0, t_bound)
         n = self.n_dof
@@ -252,7 +255,7 @@ class IDA(Integrator):
         self._steps += 1
         return StepOutcome(ok=True, t=t_new, q=q, v=v, a=a)
 
-    def interpolate(self, t):
+    def interpolate(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """IDA's own BDF interpolant inside the last internal step (consistent to IDA's accuracy;
         a Hermite interpolant of (q, v, a) would amplify their O(rtol) inconsistency by 1/h^2)."""
         if not (self.previous is not None and self.previous[0] <= t <= self.t):
@@ -263,7 +266,7 @@ class IDA(Integrator):
         self._replay = True
         return self._split(np.asarray(out.y).reshape(-1), np.asarray(out.yp).reshape(-1))
 
-    def restart(self, t, q, v, a, model=None) -> None:
+    def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model | None = None) -> None:
         """Re-initialise IDA at a state changed by a model event (BDF history lost)."""
         super().restart(t, q, v, a, model)
         self._solver.init_step(float(t), *self._join(q, v, a))

@@ -40,8 +40,9 @@ from ancfdae import _validate as V
 from ancfdae.integrators._affine import affine2, stage_constants, stage_states
 from ancfdae.integrators._base import FixedStepIntegrator
 from ancfdae.integrators._linsolve import StageMatrix
+from ancfdae.integrators._newton import NewtonOptions
 from ancfdae.integrators.protocol import Quadrature
-from ancfdae.problem import capabilities
+from ancfdae.problem import Model, capabilities
 
 __all__ = ["ButcherTableau", "LOBATTO_IIIA_2", "LOBATTO_IIIA_3", "LobattoIIIA"]
 
@@ -155,7 +156,8 @@ class LobattoIIIA(FixedStepIntegrator):
         instead of 4.7 iterations per step.
     """
 
-    def __init__(self, model, h, stages=3, *, newton=None, predictor="constant"):
+    def __init__(self, model: Model, h: float, stages: int | ButcherTableau = 3, *,
+                 newton: NewtonOptions | dict | None = None, predictor: str = "constant") -> None:
         super().__init__(model, h, newton=newton)
         if isinstance(stages, ButcherTableau):
             tab = stages
@@ -178,7 +180,7 @@ class LobattoIIIA(FixedStepIntegrator):
         self._c = tab.c[1:].copy()
         self._perm = None
 
-    def options(self):
+    def options(self) -> dict:
         o = super().options()
         o.update(stages=self.tableau.stages, predictor=self.predictor)
         return o

@@ -31,6 +31,8 @@ import numbers
 
 from ancfdae.integrators._affine import affine2, affine3, newmark_predict
 from ancfdae.integrators._base import FixedStepIntegrator
+from ancfdae.integrators._newton import NewtonOptions
+from ancfdae.problem import Model
 
 __all__ = ["Newmark", "HHTAlpha", "GeneralizedAlpha"]
 
@@ -50,7 +52,7 @@ class _AlphaFamily(FixedStepIntegrator):
         super().__init__(model, h, newton=newton)
         self.beta, self.gamma, self.alpha_m, self.alpha_f = beta, gamma, alpha_m, alpha_f
 
-    def options(self):
+    def options(self) -> dict:
         o = super().options()
         o.update(beta=self.beta, gamma=self.gamma, alpha_m=self.alpha_m, alpha_f=self.alpha_f)
         return o
@@ -98,7 +100,8 @@ class Newmark(_AlphaFamily):
 
     name = "newmark"
 
-    def __init__(self, model, h, beta=0.25, gamma=0.5, *, newton=None):
+    def __init__(self, model: Model, h: float, beta: float = 0.25, gamma: float = 0.5, *,
+                 newton: NewtonOptions | dict | None = None) -> None:
         super().__init__(model, h, _param("beta", beta, 0.0, 0.5), _param("gamma", gamma, 0.0, 1.0),
                          0.0, 0.0, newton)
         self.order = 2 if self.gamma == 0.5 else 1
@@ -122,12 +125,13 @@ class HHTAlpha(_AlphaFamily):
 
     name = "hht"
 
-    def __init__(self, model, h, alpha=0.05, *, newton=None):
+    def __init__(self, model: Model, h: float, alpha: float = 0.05, *,
+                 newton: NewtonOptions | dict | None = None) -> None:
         alpha = _param("alpha", alpha, 0.0, 1.0 / 3.0)
         super().__init__(model, h, (1 + alpha) ** 2 / 4, 0.5 + alpha, 0.0, alpha, newton)
         self.alpha = alpha
 
-    def options(self):
+    def options(self) -> dict:
         o = super().options()
         o["alpha"] = self.alpha
         return o
@@ -151,13 +155,14 @@ class GeneralizedAlpha(_AlphaFamily):
 
     name = "generalized-alpha"
 
-    def __init__(self, model, h, rho_inf=0.8, *, newton=None):
+    def __init__(self, model: Model, h: float, rho_inf: float = 0.8, *,
+                 newton: NewtonOptions | dict | None = None) -> None:
         rho = _param("rho_inf", rho_inf, 0.0, 1.0)
         am, af = (2 * rho - 1) / (rho + 1), rho / (rho + 1)
         super().__init__(model, h, (1 - am + af) ** 2 / 4, 0.5 - am + af, am, af, newton)
         self.rho_inf = rho
 
-    def options(self):
+    def options(self) -> dict:
         o = super().options()
         o["rho_inf"] = self.rho_inf
         return o

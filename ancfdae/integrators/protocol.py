@@ -44,9 +44,14 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
+
+from ancfdae.problem import Model
+
+if TYPE_CHECKING:                       # the result module imports the integrators
+    from ancfdae.result import Result
 
 __all__ = ["Quadrature", "StepOutcome", "Integrator"]
 
@@ -124,7 +129,7 @@ class Integrator(ABC):
     consistent_restart: bool = False
     want_quadrature: bool = False
 
-    def __init__(self, model, h: float | None = None):
+    def __init__(self, model: Model, h: float | None = None) -> None:
         self.model = model
         self.h = h
 
@@ -151,7 +156,7 @@ class Integrator(ABC):
         t0, q0, v0, a0 = self.previous
         return hermite5(t0, (q0, v0, a0), self.t, (self.q, self.v, self.a), t)
 
-    def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model=None) -> None:
+    def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model | None = None) -> None:
         """Continue from a state changed by a model event (history is dropped)."""
         if model is not None:
             self.model = model
@@ -168,7 +173,7 @@ class Integrator(ABC):
         """The integrator's options as a JSON-able dict."""
         return {"h": self.h} if self.fixed_step else {}
 
-    def run(self, t_span, **kwargs):
+    def run(self, t_span: tuple[float, float], **kwargs: Any) -> Result:
         """Integrate ``self.model`` over ``t_span`` through the driver.
 
         Keyword arguments are those of :func:`ancfdae.simulate` without ``method``, ``h`` and the

@@ -13,11 +13,11 @@ class BE3DEvents:
     """Event methods of :class:`~ancfdae.models.be3d.BE3D` (a mixin: it uses the element's
     ``director_update`` and ``update_below``)."""
 
-    def event_state(self, geom) -> dict:
+    def event_state(self, geom: dict) -> dict:
         """``{"directors": (n_nodes, 3)}``: the nodal directors, carried by the driver between steps."""
         return {"directors": geom["directors"]}
 
-    def bind(self, geom, state) -> dict:
+    def bind(self, geom: dict, state: dict) -> dict:
         """``geom`` with the nodal directors of ``state`` (read-only; ``geom`` itself is unchanged)."""
         D = np.array(state["directors"], dtype=float)
         if D.shape != geom["directors"].shape:
@@ -25,7 +25,7 @@ class BE3DEvents:
         D.setflags(write=False)
         return dict(geom, directors=D)
 
-    def step_event(self, geom, Q, V):
+    def step_event(self, geom: dict, Q: np.ndarray, V: np.ndarray) -> tuple | None:
         """Director update of Sect. 3.6 (``director_update``, ``update_below``); None when not done.
 
         See :func:`._be3d_dynamics.update_directors`.

@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import copy
 
+import numpy as np
+
 __all__ = ["BeamEvents"]
 
 
@@ -33,7 +35,7 @@ class BeamEvents:
         other.geom = self.element.bind(self.geom, state)
         return other
 
-    def step_event(self, t, q, v):
+    def step_event(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple | None:
         """The element's event after an accepted step (BE3D director update); None when nothing changed."""
         ev = self.element.step_event(self.geom, self.nodal(q), self._expand_v(v).reshape(self.n_nodes, -1))
         if ev is None:

@@ -87,7 +87,7 @@ class BeamLoads:
         fnc, kload = self._f_nonconservative(t, self.expand(q), tangent)
         return fnc + self._f_gravity, kload
 
-    def external_power(self, t, q, v) -> float:
+    def external_power(self, t: float, q: np.ndarray, v: np.ndarray) -> float:
         """Power of all loads except gravity (whose work is the potential)."""
         self._check(q, v)
         f, _ = self._f_nonconservative(t, self.expand(q), False)

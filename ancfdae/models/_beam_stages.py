@@ -5,6 +5,7 @@ from __future__ import annotations
 import functools
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._validate import check_shape
 
@@ -22,7 +23,7 @@ class BeamStages:
     """Stage methods of :class:`~ancfdae.models.beam.Beam` (a mixin: it uses the beam's element, assembler
     and the fused entry point)."""
 
-    def residual_stages(self, ts, Q, V, A):
+    def residual_stages(self, ts: ArrayLike, Q: np.ndarray, V: np.ndarray, A: np.ndarray) -> np.ndarray:
         """Residuals of several stages in one element pass: column ``i`` of the (n_dof, m) result is
         ``residual(ts[i], Q[:, i], V[:, i], A[:, i])`` (optional Model method; Lobatto IIIA uses it).
 

@@ -25,7 +25,7 @@ Conventions
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from typing import Any, ClassVar
+from typing import Any, Callable, ClassVar
 
 import numpy as np
 
@@ -186,7 +186,7 @@ class Element(ABC):
         """
 
     # -- optional: fused compiled assembly ----------------------------------
-    def fused_kernel(self, geom):
+    def fused_kernel(self, geom: Any) -> tuple[Callable, tuple] | None:
         """The element's fused gather-kernel-scatter entry point, or None (the default).
 
         An element with a compiled kernel returns ``(fn, args)``; the beam then

@@ -40,7 +40,7 @@ class KernelOption:
         return self._kernel
 
     @kernel.setter
-    def kernel(self, value):
+    def kernel(self, value: str) -> None:
         self._impl = resolve_kernel(value)
         self._kernel = value
 

@@ -18,21 +18,23 @@ class PotentialMixin:
     """``potential``, ``potential_gradient``, ``nonconservative_force``, ``symmetry_generators``."""
 
     @property
-    def potential_degree(self):
+    def potential_degree(self) -> int | None:
         """Polynomial degree of ``P`` in the coordinates, or None (from the element's ``energy_degree``)."""
         return getattr(self.element, "energy_degree", None)
 
-    def potential(self, t, q) -> float:
+    def potential(self, t: float, q: np.ndarray) -> float:
         """``U(q) + V(q)``, with the gravity potential zero in the reference configuration."""
         U = float(np.sum(self.element.strain_energy(self.geom, self._element_q(q))))
         return U - self.load_factor * float(self._f_gravity @ (q - self.q_ref[self.free]))
 
-    def potential_gradient(self, t, q, tangent=True):
+    def potential_gradient(self, t: float, q: np.ndarray,
+                           tangent: bool = True) -> tuple[np.ndarray, sp.csr_matrix | None]:
         """``(dU/dq - lambda f_gravity, d2U/dq2 as CSR or None)``."""
         g, kdata = self.internal_forces(q, tangent)
         return g - self.load_factor * self._f_gravity, (self._asm.csr(kdata) if tangent else None)
 
-    def nonconservative_force(self, t, q, tangent=True):
+    def nonconservative_force(self, t: float, q: np.ndarray,
+                             tangent: bool = True) -> tuple[np.ndarray, sp.csr_matrix | None]:
         """Dead forces and moments ``(f_nc, df_nc/dq as CSR or None)`` (every load except gravity)."""
         f, kdata = self._f_nonconservative(t, self.expand(q), tangent)
         if not tangent:
@@ -40,7 +42,7 @@ class PotentialMixin:
         kdata = self._zero_data if kdata is None else kdata
         return self.load_factor * f, self._asm.csr(self.load_factor * kdata)
 
-    def symmetry_generators(self):
+    def symmetry_generators(self) -> tuple[np.ndarray, list[sp.csr_matrix]]:
         """Translations of the nodal positions and rotations of every nodal vector (free beams only).
 
         Every node of a constant-mass ANCF element carries ``n_node_dof / dim``

@@ -8,7 +8,10 @@ from __future__ import annotations
 
 import numbers
 
+from typing import Callable
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._validate import choice
 from ..materials import CircularSection, Material, RectangularSection
@@ -39,8 +42,9 @@ class SQElement(KernelOption, Element):
     #: term of each structural strain component, in the order returned by ``_strains``
     _terms: tuple[str, ...] = ()
 
-    def __init__(self, material: Material, section, formulation: str = "structural", nodes: int = 3,
-                 quadrature: dict | None = None, kernel: str = "auto"):
+    def __init__(self, material: Material, section: RectangularSection | CircularSection,
+                 formulation: str = "structural", nodes: int = 3, quadrature: dict | None = None,
+                 kernel: str = "auto") -> None:
         if not isinstance(material, Material):
             raise TypeError(f"`material` must be an ancfdae Material, got {material!r}.")
         self.formulation = choice("formulation", formulation, self.formulations)
@@ -66,7 +70,7 @@ class SQElement(KernelOption, Element):
                 f"quadrature={self.quadrature!r}, kernel={self._kernel!r})")
 
     @property
-    def energy_degree(self):
+    def energy_degree(self) -> int | None:
         """4 for the continuum formulations (St. Venant-Kirchhoff energy of the Green strain, which is
         quadratic in q, Eqs. 13, 28-33); None for the structural one (|r'| and the frame of Eq. 7)."""
         return None if self.formulation == "structural" else 4
@@ -121,18 +125,18 @@ class SQElement(KernelOption, Element):
     def _nvec(self) -> int:
         return self.dim           # vectors per node: r and the dim-1 cross-section slopes
 
-    def reference_coordinates(self, points, frames):
+    def reference_coordinates(self, points: np.ndarray, frames: np.ndarray) -> np.ndarray:
         """``[r, e_2(, e_3)]`` per node: unit cross-section slopes along the reference frame."""
         return np.concatenate([points] + [frames[:, :, k] for k in range(1, self.dim)], axis=1)
 
-    def support_coordinates(self, kind, frame):
+    def support_coordinates(self, kind: str, frame: np.ndarray) -> tuple[str, ...]:
         """Clamp: position and every cross-section slope coordinate; pin: position."""
         if kind == "pin":
             return self.node_coordinates[:self.dim]
         return self.node_coordinates
 
     # -- preparation ------------------------------------------------------------------------
-    def prepare(self, q_ref, lengths):
+    def prepare(self, q_ref: np.ndarray, lengths: np.ndarray) -> dict:
         lengths = np.asarray(lengths, dtype=float)
         geom = {"L": lengths, "M": self._mass(lengths, q_ref)}
         if self.formulation == "structural":
@@ -288,7 +292,7 @@ class SQElement(KernelOption, Element):
             return _sq_numba.sq_structural(q, *nbg, self.dim, order)
         return _sq_numba.sq_continuum(q, *nbg, self.dim, order)
 
-    def fused_kernel(self, geom):
+    def fused_kernel(self, geom: dict) -> tuple[Callable, tuple] | None:
         """The fused compiled entry point ``(fn, args)`` with the compiled kernel selected, else None."""
         if self._impl != "numba":
             return None
@@ -305,22 +309,23 @@ class SQElement(KernelOption, Element):
     def _stiffness_count(self) -> int:
         return len(self._terms)
 
-    def mass_matrix(self, geom):
+    def mass_matrix(self, geom: dict) -> np.ndarray:
         return geom["M"]
 
-    def strain_energy(self, geom, q):
+    def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
         if self._impl == "numba":
             return self._evaluate_numba(geom, q, 0)[0]
         return self._evaluate(geom, q, 0)[0]
 
-    def internal_forces(self, geom, q, tangent=True):
+    def internal_forces(self, geom: dict, q: np.ndarray,
+                        tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         if self._impl == "numba":
             _, f, K = self._evaluate_numba(geom, q, 2 if tangent else 1)
             return f, (K if tangent else None)
         _, f, K = self._evaluate(geom, q, 2 if tangent else 1)
         return f, K
 
-    def shape_matrix(self, s, lengths):
+    def shape_matrix(self, s: ArrayLike, lengths: ArrayLike) -> np.ndarray:
         N, _ = shapes(self.nodes, np.asarray(s, dtype=float), np.asarray(lengths, dtype=float))
         E, P, nn = N.shape
         S = np.zeros((E, P, self.dim, nn, self._nvec, self.dim))
@@ -333,7 +338,8 @@ class SQElement(KernelOption, Element):
         N, dN = shapes(self.nodes, np.array([float(s)]), geom["L"][[element]])
         return local_map(N, dN, self.dim)[0, 0, :self.dim * (self.dim - 1)]
 
-    def moment_load(self, geom, q, s, moment, element, tangent=True):
+    def moment_load(self, geom: dict, q: np.ndarray, s: float, moment: np.ndarray, element: int,
+                    tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         if self._impl == "numba":
             from ._sq_numba_moment import sq_moment_load
             f, K = sq_moment_load(np.ascontiguousarray(q, dtype=float), float(s), self.nodes, self.dim,

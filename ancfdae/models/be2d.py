@@ -14,10 +14,13 @@ exact, for all elements and points in a few ``einsum`` calls.
 """
 from __future__ import annotations
 
+from typing import Callable
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._validate import choice, positive_int
-from ..materials import Material
+from ..materials import CircularSection, Material, RectangularSection
 from ._element import Element
 from ._kernel_option import KernelOption
 from ._quadrature import gauss
@@ -75,8 +78,9 @@ class BE2D(KernelOption, Element):
     node_coordinates = ("x", "y", "x'", "y'")
     formulations = ("structural", "continuum")
 
-    def __init__(self, material: Material, section, formulation: str = "structural",
-                 axial_points: int = 5, bending_points: int = 3, kernel: str = "auto"):
+    def __init__(self, material: Material, section: RectangularSection | CircularSection,
+                 formulation: str = "structural", axial_points: int = 5, bending_points: int = 3,
+                 kernel: str = "auto") -> None:
         if not isinstance(material, Material):
             raise TypeError(f"`material` must be a Material, got {material!r}.")
         for attr in ("A", "I3", "I4"):
@@ -94,10 +98,10 @@ class BE2D(KernelOption, Element):
                 f"bending_points={self.bending_points}, kernel={self._kernel!r})")
 
     # -- mesh -----------------------------------------------------------
-    def reference_coordinates(self, points, frames):
+    def reference_coordinates(self, points: np.ndarray, frames: np.ndarray) -> np.ndarray:
         return np.concatenate([points, frames[:, :, 0]], axis=1)
 
-    def support_coordinates(self, kind, frame):
+    def support_coordinates(self, kind: str, frame: np.ndarray) -> tuple[str, ...]:
         if kind == "pin":
             return ("x", "y")
         # Clamp: fix the transverse slope only, so the axial strain at the
@@ -110,7 +114,7 @@ class BE2D(KernelOption, Element):
             return ("x", "y", "x'")
         return ("x", "y", "x'", "y'")
 
-    def prepare(self, q_ref, lengths):
+    def prepare(self, q_ref: np.ndarray, lengths: np.ndarray) -> dict:
         # One concatenated point set: the axial rule's points first, then the
         # bending rule's; masks select which density acts where. Arrays are
         # stored points-last ("structure of arrays", (..., n_el, n_pts)) so that
@@ -223,14 +227,15 @@ class BE2D(KernelOption, Element):
             out[5][:, na:] = E * (I * phi + 6 * I4 * c2 * psi)
         return out
 
-    def mass_matrix(self, geom):
+    def mass_matrix(self, geom: dict) -> np.ndarray:
         return geom["M"]
 
-    def strain_energy(self, geom, q):
+    def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
         g, c = self._invariants(geom, q, derivatives=False)
         return np.sum(geom["w"] * self._densities(g, c, geom, hessian=False)[0], axis=1)
 
-    def internal_forces(self, geom, q, tangent=True):
+    def internal_forces(self, geom: dict, q: np.ndarray,
+                        tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         if self._impl == "numba":
             return self._internal_forces_numba(geom, q, tangent)
         w = geom["w"]
@@ -270,17 +275,18 @@ class BE2D(KernelOption, Element):
         f, K = nb.be2d_forces(np.ascontiguousarray(q, dtype=float), *args, bool(tangent))
         return f, (K if tangent else None)
 
-    def fused_kernel(self, geom):
+    def fused_kernel(self, geom: dict) -> tuple[Callable, tuple] | None:
         """``(be2d_fused, args)`` with the compiled kernel selected, else None (see :class:`Element`)."""
         if self._impl != "numba":
             return None
         return self._numba_args(geom)[2]
 
-    def shape_matrix(self, s, lengths):
+    def shape_matrix(self, s: ArrayLike, lengths: ArrayLike) -> np.ndarray:
         N, _, _ = hermite(np.asarray(s, dtype=float), lengths)
         return _expand2(N)
 
-    def moment_load(self, geom, q, s, moment, element, tangent=True):
+    def moment_load(self, geom: dict, q: np.ndarray, s: float, moment: np.ndarray, element: int,
+                    tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """Dead moment ``M_z`` at ``s``: ``delta phi = (r' x delta r').e_z / |r'|^2``."""
         L = geom["L"][[element]]
         _, dN, _ = hermite(np.array([s]), L)

@@ -9,8 +9,10 @@ Eq. 62 and the linear angle of Eqs. 101-103. Kinematics in
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._validate import choice, finite_vector, positive_int
+from ..materials import CircularSection, Material, RectangularSection
 from ._be3d_dynamics import UPDATES, rotary_inertia, rotary_kinetic_energy
 from ._be3d_events import BE3DEvents
 from ._be3d_kinematics import curvature_energy, curvatures, director_field, frames, spin_gradient
@@ -109,9 +111,10 @@ class BE3D(KernelOption, BE3DEvents, Element):
     node_coordinates = ("x", "y", "z", "x'", "y'", "z'", "theta")
     mass_is_constant = False
 
-    def __init__(self, material, section, director_update: str = "projected", director=None,
+    def __init__(self, material: Material, section: RectangularSection | CircularSection,
+                 director_update: str = "projected", director: ArrayLike | None = None,
                  axial_points: int = 5, bending_points: int = 3, inertia_points: int = 3,
-                 update_below: float | None = None, kernel: str = "auto"):
+                 update_below: float | None = None, kernel: str = "auto") -> None:
         check_material_section(material, section, ("A", "I2", "I3", "J", "k_t"))
         self.material = material
         self.section = section
@@ -142,7 +145,7 @@ class BE3D(KernelOption, BE3DEvents, Element):
                 f"kernel={self._kernel!r})")
 
     # -- mesh -------------------------------------------------------------
-    def reference_coordinates(self, points, frames_):
+    def reference_coordinates(self, points: np.ndarray, frames_: np.ndarray) -> np.ndarray:
         """``(r, e1, theta_ref)`` per node; keeps the initial nodal directors for :meth:`prepare`.
 
         The director is ``e3`` of each node's frame (``theta_ref = 0``), or the
@@ -164,7 +167,7 @@ class BE3D(KernelOption, BE3DEvents, Element):
         self._pending = D
         return np.concatenate([points, e1, theta[:, None]], axis=1)
 
-    def support_coordinates(self, kind, frame):
+    def support_coordinates(self, kind: str, frame: np.ndarray) -> tuple[str, ...]:
         """``"pin"``: r; ``"clamp"``: r, the slope components transverse to the reference tangent, theta.
 
         With a tangent along a global axis the axial slope component stays
@@ -184,7 +187,7 @@ class BE3D(KernelOption, BE3DEvents, Element):
         rule.Bx = np.concatenate([rule.Ba, rule.Bb, rule.Nt[:, :, None, :], rule.dNt[:, :, None, :]], axis=2)
         return rule
 
-    def prepare(self, q_ref, lengths):
+    def prepare(self, q_ref: np.ndarray, lengths: np.ndarray) -> dict:
         q_ref = np.asarray(q_ref, dtype=float)
         lengths = np.asarray(lengths, dtype=float)
         n_el = lengths.size
@@ -233,12 +236,12 @@ class BE3D(KernelOption, BE3DEvents, Element):
     def _curvatures(self, geom, q, second, rule=None):
         return curvatures(*self._local(geom, q, geom["bend"] if rule is None else rule), second=bool(second))
 
-    def curvature(self, geom, q, s):
+    def curvature(self, geom: dict, q: np.ndarray, s: ArrayLike) -> np.ndarray:
         """Twist and curvatures ``(k1, k2, k3)`` per xi at normalised coordinates ``s``, shape (n_el, n_pts, 3)."""
         rule = self._rule(np.atleast_1d(np.asarray(s, dtype=float)), geom["L"])
         return np.stack([k.v for k in self._curvatures(geom, q, False, rule)], axis=-1)
 
-    def spin(self, geom, q, v, s):
+    def spin(self, geom: dict, q: np.ndarray, v: np.ndarray, s: ArrayLike) -> np.ndarray:
         """Angular velocity of the cross-section about the axis, ``omega . e1``, shape (n_el, n_pts)."""
         rule = self._rule(np.atleast_1d(np.asarray(s, dtype=float)), geom["L"])
         a = np.einsum("epin,en->epi", rule.Ba, q)
@@ -246,7 +249,7 @@ class BE3D(KernelOption, BE3DEvents, Element):
         g, _ = spin_gradient(a, d)
         return np.einsum("epn,en->ep", rule.Nt, v) + np.einsum("epi,epin,en->ep", g, rule.Ba, v)
 
-    def mass_matrix(self, geom):
+    def mass_matrix(self, geom: dict) -> np.ndarray:
         """Constant part ``rho A int S^T S dxi`` (zero rows and columns for theta)."""
         return geom["M"]
 
@@ -263,14 +266,15 @@ class BE3D(KernelOption, BE3DEvents, Element):
                            bd.dN, bd.ddN, bd.wdx, bd.lin, geom["L"], self._directors(geom),
                            geom["k_ref"], self.D, self.EA, bool(tangent))
 
-    def strain_energy(self, geom, q):
+    def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
         if self._impl == "numba":
             return self._compiled_forces(geom, q, False)[0]
         U, _, _ = axial_energy(geom["axial"], q, geom["slope_ref"], self.EA, False)
         W, _ = curvature_energy(*self._local(geom, q, geom["bend"]), geom["k_ref"], self.D)
         return U + np.sum(geom["bend"].wdx * W, axis=1)
 
-    def internal_forces(self, geom, q, tangent=True):
+    def internal_forces(self, geom: dict, q: np.ndarray,
+                        tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         if self._impl == "numba":
             _, f, K = self._compiled_forces(geom, q, tangent)
             return f, (K if tangent else None)
@@ -290,18 +294,19 @@ class BE3D(KernelOption, BE3DEvents, Element):
         f = f + np.einsum("epvn,epv->en", rule.Bx, grad)
         return f, K + assemble(rule.Bx, hess)
 
-    def shape_matrix(self, s, lengths):
+    def shape_matrix(self, s: ArrayLike, lengths: ArrayLike) -> np.ndarray:
         N, _, _ = hermite(np.asarray(s, dtype=float), np.asarray(lengths, dtype=float))
         return hermite_operator(N, _DOF, _NDOF)
 
-    def frames(self, geom, q, s):
+    def frames(self, geom: dict, q: np.ndarray, s: ArrayLike) -> np.ndarray:
         """Cross-section frames at normalised coordinates ``s``, shape (n_el, n_pts, 3, 3), columns e1, e2, e3."""
         rule = self._rule(np.atleast_1d(np.asarray(s, dtype=float)), geom["L"])
         a, _, th, _, d, _ = self._local(geom, q, rule)
         F, _ = frames(a, th, d)
         return F
 
-    def moment_load(self, geom, q, s, moment, element, tangent=True):
+    def moment_load(self, geom: dict, q: np.ndarray, s: float, moment: np.ndarray, element: int,
+                    tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """Dead moment at ``s``: ``f = G^T M`` with the virtual rotation of the frame.
 
         ``delta phi = e1 x delta e1 + (delta theta + g . delta r') e1``
@@ -341,7 +346,7 @@ class BE3D(KernelOption, BE3DEvents, Element):
         dfa = np.array([x.g for x in fa])
         return f, Sx.T @ dfa @ Sx + np.outer(Nt, Me1.g @ Sx)
 
-    def inertia(self, geom, q, v, a, jacobian=True):
+    def inertia(self, geom: dict, q: np.ndarray, v: np.ndarray, a: np.ndarray, jacobian: bool = True) -> tuple:
         """Rotary inertia about the axis: ``f``, and ``df/dq, df/dv, df/da`` (exact).
 
         From ``T_rot = 1/2 int rho J omega1^2 dxi`` with the spin
@@ -361,7 +366,7 @@ class BE3D(KernelOption, BE3DEvents, Element):
             return (f, Kq, Dv, Ma) if jacobian else (f, None, None, None)
         return rotary_inertia(geom["inertia"], geom, q, v, a, self.rhoJ, jacobian)
 
-    def kinetic_energy_extra(self, geom, q, v):
+    def kinetic_energy_extra(self, geom: dict, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``1/2 int rho J omega1^2 dxi`` per element."""
         if self._impl == "numba":
             from ._be3d_inertia_numba import be3d_kinetic_energy

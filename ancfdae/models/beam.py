@@ -10,9 +10,11 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Iterable
+from typing import Callable
 
 import numpy as np
 import scipy.sparse as sp
+from numpy.typing import ArrayLike
 
 from ..loads import DistributedLoad, Gravity, PointForce, PointMoment
 from ..problem import Energy, JacobianBlocks
@@ -86,8 +88,12 @@ class Beam(PotentialMixin, BeamChecks, BeamLoads, BeamStages, BeamEvents):
     :class:`~ancfdae.models._potential.PotentialMixin`).
     """
 
-    def __init__(self, element: Element, n_elements=None, length=None, start=None, direction=None, *,
-                 nodes=None, normal=None, supports=None, loads=(), initial_velocity=None):
+    def __init__(self, element: Element, n_elements: int | None = None, length: float | None = None,
+                 start: ArrayLike | None = None, direction: ArrayLike | None = None, *,
+                 nodes: ArrayLike | None = None, normal: ArrayLike | None = None, supports: dict | None = None,
+                 loads: (DistributedLoad | Gravity | PointForce | PointMoment
+                        | Iterable[DistributedLoad | Gravity | PointForce | PointMoment]) = (),
+                 initial_velocity: Callable | ArrayLike | None = None) -> None:
         if not isinstance(element, Element):
             raise TypeError(f"`element` must be an ancfdae element (e.g. BE2D(...)), got {element!r}.")
         self.element = element
@@ -171,7 +177,7 @@ class Beam(PotentialMixin, BeamChecks, BeamLoads, BeamStages, BeamEvents):
         return self._assembly
 
     @assembly.setter
-    def assembly(self, value):
+    def assembly(self, value: str) -> None:
         if value not in ("fused", "numpy"):
             raise ValueError(f"`assembly` must be 'fused' or 'numpy', got {value!r}.")
         self._assembly = value
@@ -192,7 +198,7 @@ class Beam(PotentialMixin, BeamChecks, BeamLoads, BeamStages, BeamEvents):
         """Coordinates per node, shape (n_nodes, n_node_dof)."""
         return self.expand(q).reshape(self.n_nodes, -1)
 
-    def point_matrix(self, s) -> sp.csr_matrix:
+    def point_matrix(self, s: ArrayLike) -> sp.csr_matrix:
         """Sparse operator P with ``r(s) = P @ expand(q)``, shape (n_pts*dim, n_full)."""
         e, loc = self._locate(s)
         dim, nd = self.element.dim, self.element.n_edof
@@ -205,7 +211,7 @@ class Beam(PotentialMixin, BeamChecks, BeamLoads, BeamStages, BeamEvents):
         return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                              shape=(len(e) * dim, self.q_ref.size))
 
-    def position(self, q: np.ndarray, s) -> np.ndarray:
+    def position(self, q: np.ndarray, s: ArrayLike) -> np.ndarray:
         """Axis position at reference arc length ``s`` (scalar -> (dim,), array -> (n, dim))."""
         self._check(q)
         r = (self.point_matrix(s) @ self.expand(q)).reshape(-1, self.element.dim)
@@ -222,11 +228,11 @@ class Beam(PotentialMixin, BeamChecks, BeamLoads, BeamStages, BeamEvents):
         return _describe.dof_labels(self)
 
     # -- the Model contract -------------------------------------------------
-    def initial_state(self):
+    def initial_state(self) -> tuple[np.ndarray, np.ndarray]:
         """Reference configuration and the initial velocity."""
         return self.q_ref[self.free].copy(), self._v0.copy()
 
-    def mass(self, q=None) -> sp.csr_matrix:
+    def mass(self, q: np.ndarray | None = None) -> sp.csr_matrix:
         """Mass matrix M(q) (constant unless the element says otherwise; ``q=None``: the reference state)."""
         if q is not None:
             self._check(q)
@@ -253,7 +259,7 @@ class Beam(PotentialMixin, BeamChecks, BeamLoads, BeamStages, BeamEvents):
         """The element's fused entry point ``(fn, args)`` for ``geom``, or None (NumPy assembly)."""
         return self.element.fused_kernel(geom) if self._assembly == "fused" else None
 
-    def internal_forces(self, q, tangent=True):
+    def internal_forces(self, q: np.ndarray, tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """Assembled ``dU/dq`` (free vector) and tangent CSR data (or None)."""
         return self._assemble(q, tangent)[:2]
 
@@ -280,7 +286,7 @@ class Beam(PotentialMixin, BeamChecks, BeamLoads, BeamStages, BeamEvents):
             return f
         return f + self._M_csr @ a - self.load_factor * fext
 
-    def residual(self, t, q, v, a):
+    def residual(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
         """``r = M(q) a + f_int(q) [+ inertia(q, v, a)] - lambda f_ext(t, q)``."""
         self._check(q, v, a)
         f, _, fused = self._assemble(q, False)
@@ -289,7 +295,8 @@ class Beam(PotentialMixin, BeamChecks, BeamLoads, BeamStages, BeamEvents):
             r += self._inertia(q, v, a, False)[0]
         return r
 
-    def residual_jacobian(self, t, q, v, a):
+    def residual_jacobian(self, t: float, q: np.ndarray, v: np.ndarray,
+                          a: np.ndarray) -> tuple[np.ndarray, JacobianBlocks]:
         """``(residual, jacobian)`` from one kernel pass (the fused path of full Newton)."""
         self._check(q, v, a)
         f, K, fused = self._assemble(q, True)
@@ -305,7 +312,7 @@ class Beam(PotentialMixin, BeamChecks, BeamLoads, BeamStages, BeamEvents):
         return r, JacobianBlocks(self._asm.csr(K), self._asm.csr(D.copy()), self._asm.csr(M.copy()),
                                  same_pattern=True)
 
-    def jacobian(self, t, q, v, a) -> JacobianBlocks:
+    def jacobian(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> JacobianBlocks:
         """Exact ``dr/dq``, ``dr/dv``, ``dr/da`` with one shared CSR pattern."""
         self._check(q, v, a)
         _, K = self.internal_forces(q, True)
@@ -319,7 +326,7 @@ class Beam(PotentialMixin, BeamChecks, BeamLoads, BeamStages, BeamEvents):
             K, D, M = K + iq, iv, M + ia
         return JacobianBlocks(self._asm.csr(K), self._asm.csr(D.copy()), self._asm.csr(M.copy()), same_pattern=True)
 
-    def energy(self, t, q, v) -> Energy:
+    def energy(self, t: float, q: np.ndarray, v: np.ndarray) -> Energy:
         """Kinetic ``1/2 v^T M v`` (+ element extra), strain, gravity potential."""
         self._check(q, v)
         T = 0.5 * v @ (self._M_csr @ v)

@@ -8,8 +8,10 @@ element. The planar BE2D element extended by a third component
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._validate import finite_vector, positive_int
+from ..materials import CircularSection, Material, RectangularSection
 from ._element import Element
 from ._kernel_option import KernelOption
 from ._shapes import hermite
@@ -75,7 +77,8 @@ class Cable3D(KernelOption, Element):
     node_params = (-1.0, 1.0)
     node_coordinates = ("x", "y", "z", "x'", "y'", "z'")
 
-    def __init__(self, material, section, axial_points: int = 5, bending_points: int = 3, kernel: str = "auto"):
+    def __init__(self, material: Material, section: RectangularSection | CircularSection, axial_points: int = 5,
+                 bending_points: int = 3, kernel: str = "auto") -> None:
         check_material_section(material, section, ("A", "I2", "I3"))
         if not np.isclose(section.I2, section.I3, rtol=_SYM_RTOL, atol=0.0):
             raise ValueError("`section` of a Cable3D must have a symmetric bending stiffness (I2 == I3, chapter "
@@ -92,10 +95,10 @@ class Cable3D(KernelOption, Element):
                 f"kernel={self._kernel!r})")
 
     # -- mesh -------------------------------------------------------------
-    def reference_coordinates(self, points, frames):
+    def reference_coordinates(self, points: np.ndarray, frames: np.ndarray) -> np.ndarray:
         return np.concatenate([points, frames[:, :, 0]], axis=1)
 
-    def support_coordinates(self, kind, frame):
+    def support_coordinates(self, kind: str, frame: np.ndarray) -> tuple[str, ...]:
         """``"pin"``: r; ``"clamp"``: r and the slope components transverse to the reference tangent.
 
         With a tangent along a global axis the axial slope component stays
@@ -103,7 +106,7 @@ class Cable3D(KernelOption, Element):
         """
         return clamp_coordinates(kind, frame)
 
-    def prepare(self, q_ref, lengths):
+    def prepare(self, q_ref: np.ndarray, lengths: np.ndarray) -> dict:
         q_ref = np.asarray(q_ref, dtype=float)
         lengths = np.asarray(lengths, dtype=float)
         geom = {"L": lengths,
@@ -129,7 +132,7 @@ class Cable3D(KernelOption, Element):
         bb = np.einsum("...i,...i", b, b)
         return (p * bb - ab**2) / p**2
 
-    def mass_matrix(self, geom):
+    def mass_matrix(self, geom: dict) -> np.ndarray:
         return geom["M"]
 
     def _compiled(self, geom, q, tangent):
@@ -140,7 +143,7 @@ class Cable3D(KernelOption, Element):
                               bd.dN, bd.ddN, bd.wdx, self.material.E * self.section.A,
                               self.material.E * self.section.I3, bool(tangent))
 
-    def strain_energy(self, geom, q):
+    def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
         if self._impl == "numba":
             return self._compiled(geom, q, False)[0]
         U, _, _ = axial_energy(geom["axial"], q, geom["slope_ref"], self.material.E * self.section.A, False)
@@ -148,7 +151,8 @@ class Cable3D(KernelOption, Element):
         K2 = self._curvature_squared(rule, q)
         return U + 0.5 * self.material.E * self.section.I3 * np.sum(rule.wdx * K2, axis=1)
 
-    def internal_forces(self, geom, q, tangent=True):
+    def internal_forces(self, geom: dict, q: np.ndarray,
+                        tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         if self._impl == "numba":
             _, f, K = self._compiled(geom, q, tangent)
             return f, (K if tangent else None)
@@ -185,11 +189,12 @@ class Cable3D(KernelOption, Element):
         B = np.concatenate([rule.Ba, rule.Bb], axis=2)                     # (n_el, n_pts, 6, 12)
         return f, K + assemble(B, H)
 
-    def shape_matrix(self, s, lengths):
+    def shape_matrix(self, s: ArrayLike, lengths: ArrayLike) -> np.ndarray:
         N, _, _ = hermite(np.asarray(s, dtype=float), np.asarray(lengths, dtype=float))
         return hermite_operator(N, _DOF, 12)
 
-    def moment_load(self, geom, q, s, moment, element, tangent=True):
+    def moment_load(self, geom: dict, q: np.ndarray, s: float, moment: np.ndarray, element: int,
+                    tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """Dead moment at ``s``: virtual rotation ``delta phi = r' x delta r' / |r'|^2`` (bending only).
 
         A cable has no torsional coordinate, so the virtual rotation of its

@@ -9,13 +9,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._jet import combine, cross, dot, mul, recip, sqrt, variables
+from ._jet import Jet, combine, cross, dot, mul, recip, sqrt, variables
 from ._sq_common import SQElement, shear_factors
 
 __all__ = ["SQ3D"]
 
 
-def frame(a2, a3):
+def frame(a2: Jet, a3: Jet) -> tuple[Jet, Jet, Jet, Jet, Jet, Jet]:
     """The local frame of chapter Eq. 7 from the slope jets ``a2 = x_eta``, ``a3 = x_zeta``.
 
     Returns the jets ``e1, e2, e3`` and the scalars ``m = |a3|``,
