@@ -70,14 +70,8 @@ class SQ3D(SQElement):
     quadrature : dict, optional
         As for :class:`~ancfdae.models.SQ2D`.
     kernel : {"auto", "numpy", "numba"}
-        Implementation of the energy, forces and tangent. ``"numpy"``: the
-        vectorised NumPy kernels of :mod:`ancfdae.models._sq_kernels`, the
-        readable reference. ``"numba"``: one compiled loop over elements x
-        points (:mod:`ancfdae.models._sq_numba`, same results to rounding; the
-        first use compiles, 1-3 minutes on a loaded 2-core machine, then
-        loads from the on-disk cache in about a second). ``"auto"`` (default):
-        numba when importable, else NumPy. Settable later through the
-        ``kernel`` attribute; ``kernel_in_use`` says which one runs.
+        As for :class:`~ancfdae.models.SQ2D`: the compiled kernel (default)
+        or the NumPy reference.
     """
 
     name = "SQ3D"
