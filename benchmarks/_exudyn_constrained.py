@@ -22,7 +22,7 @@ import numpy as np
 from ._exudyn_base import _base_settings, _exu
 
 __all__ = ["INTEGRATORS", "constrained_settings", "solve_checked", "timed_runs", "history",
-           "observed_orders"]
+           "observed_orders", "richardson"]
 
 #: Exudyn's implicit integrators for constrained systems (module docstring)
 INTEGRATORS = ("generalized_alpha", "trapezoidal_index2")
@@ -144,3 +144,15 @@ def observed_orders(differences, ratio=2.0):
     d = np.asarray(differences, dtype=float)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.log(d[:-1] / d[1:]) / np.log(ratio)
+
+
+def richardson(coarse, fine, keys, order=2, ratio=2.0):
+    """Richardson extrapolation of sampled histories of two runs with steps h and h / ratio.
+
+    ``fine[k] + (fine[k] - coarse[k]) / (ratio**order - 1)`` for each key; both runs must share
+    their sample times. Removes the leading O(h^order) term of a smooth global error.
+    """
+    if coarse["t"].shape != fine["t"].shape or np.max(np.abs(coarse["t"] - fine["t"])) > 1e-9:
+        raise ValueError("`coarse` and `fine` must be sampled at the same times.")
+    c = ratio**order - 1.0
+    return {k: fine[k] + (fine[k] - coarse[k]) / c for k in keys}

@@ -32,7 +32,7 @@ import numpy as np
 from ancfdae._validate import choice, positive, positive_int
 
 from ._exudyn_base import _exu, _ii, _require
-from ._exudyn_constrained import constrained_settings, history, solve_checked, timed_runs
+from ._exudyn_constrained import NEWTON_ATOL, constrained_settings, history, solve_checked, timed_runs
 
 __all__ = ["SPINUP", "hub_angle", "spinup"]
 
@@ -98,10 +98,23 @@ def _build(n, w_s, clamp):
     else:
         coordinate_constraint(nodes[0], 0)
         coordinate_constraint(nodes[0], 1)
-        slope = [coordinate_constraint(nodes[0], 2, lambda mbs, t, item, off: math.cos(hub_angle(t, w_s)[0]) - 1.0,
-                                       lambda mbs, t, item, off: -math.sin(hub_angle(t, w_s)[0]) * hub_angle(t, w_s)[1]),
-                 coordinate_constraint(nodes[0], 3, lambda mbs, t, item, off: math.sin(hub_angle(t, w_s)[0]),
-                                       lambda mbs, t, item, off: math.cos(hub_angle(t, w_s)[0]) * hub_angle(t, w_s)[1])]
+
+        def slope_x(mbs, t, item, off):  # displacement of x' (reference 1)
+            return math.cos(hub_angle(t, w_s)[0]) - 1.0
+
+        def slope_x_t(mbs, t, item, off):
+            th, th_t, _ = hub_angle(t, w_s)
+            return -math.sin(th) * th_t
+
+        def slope_y(mbs, t, item, off):
+            return math.sin(hub_angle(t, w_s)[0])
+
+        def slope_y_t(mbs, t, item, off):
+            th, th_t, _ = hub_angle(t, w_s)
+            return math.cos(th) * th_t
+
+        slope = [coordinate_constraint(nodes[0], 2, slope_x, slope_x_t),
+                 coordinate_constraint(nodes[0], 3, slope_y, slope_y_t)]
         sensors["slope_reaction"] = [_sensor(mbs, "object", c, OVT.Force) for c in slope]
     sensors["tip"] = _sensor(mbs, "node", nodes[-1], OVT.Position)
     sensors["root"] = _sensor(mbs, "node", nodes[0], OVT.Coordinates)
@@ -135,7 +148,8 @@ def _outputs(mbs, sensors, clamp, w_s):
 
 
 def spinup(n_elements, h, integrator="generalized_alpha", w_s=4.0, *, clamp="hub", t_end=None,
-           output_period=0.01, rho_inf=0.9, modified_newton=True, repeats=1, strict=True):
+           output_period=0.01, rho_inf=0.9, modified_newton=True, newton_atol=NEWTON_ATOL,
+           repeats=1, strict=True):
     """B5 spin-up with Exudyn (module docstring); timed solve, outputs sampled every ``output_period``.
 
     Parameters
@@ -152,8 +166,9 @@ def spinup(n_elements, h, integrator="generalized_alpha", w_s=4.0, *, clamp="hub
         How the rheonomic clamp is written (module docstring).
     t_end : float, optional
         End time, default 30 s.
-    output_period, rho_inf, modified_newton
-        Sampling period (s); see :func:`~benchmarks._exudyn_constrained.constrained_settings`.
+    output_period, rho_inf, modified_newton, newton_atol
+        Sampling period (s); see :func:`~benchmarks._exudyn_constrained.constrained_settings`
+        (Newton relative tolerance 1e-8 always).
     repeats : int
         Timed runs (fresh model each); median wall and CPU time.
     strict : bool
@@ -168,10 +183,11 @@ def spinup(n_elements, h, integrator="generalized_alpha", w_s=4.0, *, clamp="hub
         r_tip . (-sin theta, cos theta) (m, positive ahead of the rotation); ``deflection_root``:
         the same in the frame of the root's actual slope direction, (r_tip - r_0) . (-sin psi,
         cos psi) with psi = atan2(r'(0)); it differs from ``deflection`` by about L times the
-        clamp's angle drift (index 2); ``tip_x``, ``tip_y`` (m, global); ``torque``: the hub torque on the beam about +e_z (N m); ``work``: the work of
-        the prescribed rotation, the integral of torque theta' dt (J, trapezoidal rule on the
-        samples); ``drift_position`` max |r(0)| (m) and ``drift_angle`` max |atan2(r'(0)) - theta|
-        (rad) over the samples: the clamp's constraint drift; ``root_stretch`` |r'(0)| - 1.
+        clamp's angle drift (index 2); ``tip_x``, ``tip_y`` (m, global); ``torque``: the hub
+        torque on the beam about +e_z (N m); ``work``: the work of the prescribed rotation, the
+        integral of torque theta' dt (J, trapezoidal rule on the samples); ``drift_position``
+        max |r(0)| (m) and ``drift_angle`` max |atan2(r'(0)) - theta| (rad) over the samples: the
+        clamp's constraint drift; ``root_stretch`` |r'(0)| - 1.
     """
     n = positive_int("n_elements", n_elements)
     h, w_s = positive("h", h), positive("w_s", w_s)
@@ -183,7 +199,7 @@ def spinup(n_elements, h, integrator="generalized_alpha", w_s=4.0, *, clamp="hub
     def run():
         SC, mbs, sensors = _build(n, w_s, clamp)  # SC owns mbs: keep it alive while mbs is used
         out = solve_checked(mbs, constrained_settings(t_end, h, integrator, rho_inf=rho_inf,
-                                                      modified_newton=modified_newton,
+                                                      modified_newton=modified_newton, newton_atol=newton_atol,
                                                       output_period=output_period))
         out.update(_outputs(mbs, sensors, clamp, w_s))
         return out
