@@ -1,7 +1,7 @@
 """Exudyn's side of the multibody benchmarks: converged references, self-convergence, CPU times.
 
 ``python -m benchmarks.multibody_peer {references,convergence,timings} [--case b5-4 b5-10 b6]
-[--repeats 3] [--save]``
+[--repeats 3] [--save] [--newton full]``
 
 Cases (benchmarks B5 and B6; peer models in ``_exudyn_spinup`` and ``_exudyn_slider_crank``):
 ``b5-4`` and ``b5-10`` the spin-up at w_s = 4 and 10 rad/s, ``b6`` the slider-crank (revision 1).
@@ -14,11 +14,14 @@ references
     and later commands load it; B6 is recomputed (about 10 s).
 convergence
     Self-convergence: max differences over the samples between successive meshes (fixed h) and
-    between successive steps (fixed mesh, both integrators), with the observed orders.
+    between successive steps (fixed mesh, both integrators), with the observed orders; Newton
+    absolute tolerance as for the reference (B6: 1e-8, below which the multipliers of the finest
+    steps are not polluted by the Newton tolerance).
 timings
     Median CPU time (``time.process_time`` of the solve call; wall time beside it) of ``--repeats``
     runs per integrator and step on the timing mesh, with each run's max error against the
-    reference. Failed or truncated runs are reported, never timed.
+    reference; ``--newton full`` times Exudyn's full instead of its modified Newton. Failed or
+    truncated runs are reported, never timed.
 """
 from __future__ import annotations
 
@@ -57,9 +60,10 @@ UNITS = dict(deflection="m", deflection_root="m", torque="N m", mid_deflection="
              normal_force="N", crank_torque="N m")
 
 
-def _run(case, n, h, integrator="generalized_alpha", atol=1e-6, repeats=1):
+def _run(case, n, h, integrator="generalized_alpha", atol=1e-6, repeats=1, modified_newton=True):
     c = CASES[case]
-    return c["run"](n, h, integrator, newton_atol=atol, repeats=repeats, strict=repeats > 1, **c["kw"])
+    return c["run"](n, h, integrator, newton_atol=atol, repeats=repeats, strict=repeats > 1,
+                    modified_newton=modified_newton, **c["kw"])
 
 
 def compute_reference(case):
@@ -150,26 +154,27 @@ def cmd_convergence(cases):
     for case in cases:
         c = CASES[case]
         meshes, h = c["mesh"]
-        print(f"\n{case}: mesh refinement at h = {h:g} s (generalized-alpha)")
-        _ladder(case, [(n, _run(case, n, h)) for n in meshes], "elements")
+        atol = c["ref"]["atol"]
+        print(f"\n{case}: mesh refinement at h = {h:g} s (generalized-alpha), Newton atol {atol:g}")
+        _ladder(case, [(n, _run(case, n, h, atol=atol)) for n in meshes], "elements")
         n, steps = c["steps"]
         for integ in INTEGRATORS:
             print(f"{case}: step refinement, {n} elements, {integ}")
-            _ladder(case, [(h, _run(case, n, h, integ)) for h in steps], "h")
+            _ladder(case, [(h, _run(case, n, h, integ, atol=atol)) for h in steps], "h")
 
 
-def cmd_timings(cases, repeats):
+def cmd_timings(cases, repeats, newton):
     for case in cases:
         c, ref = CASES[case], reference(case)
         n, steps = c["timing"]
-        print(f"\n{case}: {n} elements, Newton rtol 1e-8 atol 1e-6, modified Newton, median of {repeats}"
+        print(f"\n{case}: {n} elements, Newton rtol 1e-8 atol 1e-6, {newton} Newton, median of {repeats}"
               f" (errors: max over the samples against the reference)")
         print(f"  {'integrator':<20}{'h [s]':>10}{'cpu [s]':>10}{'wall [s]':>10}{'it/step':>9}"
               + "".join(f"{'err ' + k:>22}" for k in c["keys"]))
         for integ in INTEGRATORS:
             for h in steps:
                 try:
-                    r = _run(case, n, h, integ, repeats=repeats)
+                    r = _run(case, n, h, integ, repeats=repeats, modified_newton=newton == "modified")
                 except RuntimeError as err:
                     print(f"  {integ:<20}{h:10.2e}  {err}")
                     continue
@@ -184,6 +189,8 @@ def main(argv=None):
     ap.add_argument("--case", nargs="+", choices=tuple(CASES), default=list(CASES))
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--save", action="store_true", help="recompute the B5 references and store them")
+    ap.add_argument("--newton", choices=("modified", "full"), default="modified",
+                    help="Exudyn's Newton variant in the timed runs (default: its default, modified)")
     a = ap.parse_args(argv)
     if not available():
         raise SystemExit("exudyn is not installed: pip install '.[benchmark]'")
@@ -193,7 +200,7 @@ def main(argv=None):
     elif a.command == "convergence":
         cmd_convergence(a.case)
     else:
-        cmd_timings(a.case, a.repeats)
+        cmd_timings(a.case, a.repeats, a.newton)
 
 
 if __name__ == "__main__":
