@@ -3,15 +3,16 @@
 ``python -m benchmarks.multibody_peer {references,convergence,timings} [--case b5-4 b5-10 b6]
 [--repeats 3] [--save] [--newton full]``
 
-Cases (benchmarks B5 and B6; peer models in ``_exudyn_spinup`` and ``_exudyn_slider_crank``):
-``b5-4`` and ``b5-10`` the spin-up at w_s = 4 and 10 rad/s, ``b6`` the slider-crank (revision 1).
+Cases (benchmarks B5-B7; peer models in ``_exudyn_spinup``, ``_exudyn_slider_crank`` and
+``_exudyn_spatial_pendulum``): ``b5-4`` and ``b5-10`` the spin-up at w_s = 4 and 10 rad/s, ``b6``
+the slider-crank and ``b7`` the spatial pendulum with Cable3D (revision 1 each).
 
 references
     The converged reference of each case: Richardson extrapolation (order 2) of two
     generalized-alpha runs on a fine mesh with steps h and h/2, printed at a few times, with the
     difference between the two runs and the extrapolation's change as error estimates. B5 takes
     minutes, so ``--save`` stores it (``tests/data/exudyn_b5_reference.npz``, sampled every 0.01 s)
-    and later commands load it; B6 is recomputed (about 10 s).
+    and later commands load it; B6 and B7 are recomputed (about 10 s and 1 min).
 convergence
     Self-convergence: max differences over the samples between successive meshes (fixed h) and
     between successive steps (fixed mesh, both integrators), with the observed orders; Newton
@@ -33,6 +34,7 @@ import numpy as np
 from ._exudyn_base import _exu, available, module_variant
 from ._exudyn_constrained import INTEGRATORS, observed_orders, richardson
 from ._exudyn_slider_crank import slider_crank
+from ._exudyn_spatial_pendulum import spatial_pendulum
 from ._exudyn_spinup import spinup
 
 DATA = pathlib.Path(__file__).resolve().parents[1] / "tests" / "data" / "exudyn_b5_reference.npz"
@@ -55,9 +57,14 @@ CASES = {
                ref=dict(n=32, h=(2.5e-5, 1.25e-5), atol=1e-8),
                mesh=((2, 4, 8, 16, 32), 2.5e-5), steps=(8, (4e-4, 2e-4, 1e-4, 5e-5, 2.5e-5, 1.25e-5)),
                timing=(8, (2e-4, 1e-4, 5e-5, 2.5e-5))),
+    "b7": dict(run=spatial_pendulum, kw={}, keys=("payload", "energy", "momentum_z"),
+               times=(0.5, 1.0, 2.0, 3.0, 4.0, 5.0),
+               ref=dict(n=8, h=(5e-4, 2.5e-4), atol=1e-6),
+               mesh=((2, 4, 8, 16), 5e-4), steps=(4, (2e-3, 1e-3, 5e-4, 2.5e-4)),
+               timing=(4, (2e-3, 1e-3, 5e-4))),
 }
 UNITS = dict(deflection="m", deflection_root="m", torque="N m", mid_deflection="m", slider_x="m",
-             normal_force="N", crank_torque="N m")
+             normal_force="N", crank_torque="N m", payload="m", energy="J", momentum_z="kg m^2/s")
 
 
 def _run(case, n, h, integrator="generalized_alpha", atol=1e-6, repeats=1, modified_newton=True):
@@ -123,15 +130,25 @@ def cmd_references(cases, save):
         print("  t [s]   " + "".join(f"{k + ' [' + UNITS[k] + ']':>26}" for k in c["keys"]))
         for tt in c["times"]:
             i = int(np.argmin(np.abs(ref["t"] - tt)))
-            print(f"  {ref['t'][i]:6.3f}  " + "".join(f"{ref[k][i]:26.10g}" for k in c["keys"]))
+            print(f"  {ref['t'][i]:6.3f}  " + "".join(_cells(ref[k][i]) for k in c["keys"]))
         for k in c["keys"]:
-            i = int(np.argmax(np.abs(ref[k])))
-            print(f"  max |{k}| = {abs(ref[k][i]):.8g} {UNITS[k]} at t = {ref['t'][i]:.3f} s")
+            if ref[k].ndim == 1:
+                i, j = int(np.argmax(np.abs(ref[k]))), int(np.argmax(np.abs(ref[k] - ref[k][0])))
+                print(f"  max |{k}| = {abs(ref[k][i]):.8g} {UNITS[k]} at t = {ref['t'][i]:.3f} s;"
+                      f" max |{k} - {k}(0)| = {abs(ref[k][j] - ref[k][0]):.3e} at t = {ref['t'][j]:.3f} s")
     if save:
         b5 = {k: v for k, v in refs.items() if k.startswith("b5")}
         if set(b5) == {"b5-4", "b5-10"}:
             save_references(b5)
             print(f"\nstored {DATA.name} ({DATA.stat().st_size / 1e3:.0f} kB)")
+
+
+def _cells(v):
+    """A value as one 26-wide cell, or a vector as its components (3 digits fewer each)."""
+    v = np.atleast_1d(v)
+    if v.size == 1:
+        return f"{float(v[0]):26.10g}"
+    return "  " + " ".join(f"{x:.7g}" for x in v)
 
 
 def _ladder(case, runs, label, ratio=2.0):
