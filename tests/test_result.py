@@ -1,4 +1,5 @@
 """Result: time-major arrays, status, and the NetCDF4 file round trip."""
+import dataclasses
 import json
 from pathlib import Path
 
@@ -7,6 +8,7 @@ import pytest
 import xarray as xr
 
 from ancfdae import EnergyMonitor, Gravity, Material, PointSensor, RectangularSection, Result, ResultFileError, simulate
+from ancfdae import _resultfile
 from ancfdae.export import beam_of
 from ancfdae.models import BE2D, BE3D, SQ2D, SQ3D, Beam, Cable3D
 from toy_models import SpringChain
@@ -210,3 +212,8 @@ def test_a_file_written_by_earlier_code_loads_and_is_written_again_identically(t
     _assert_same(Result.load(again), old)
     beam = beam_of(old)                                    # the description still rebuilds the beam
     assert beam.element.name == "BE3D" and beam.n_dof == old.q.shape[1]
+
+
+def test_the_result_file_module_writes_every_field_of_result():
+    """Catches a field added to Result but not to the file layout (it would be lost by save/load)."""
+    assert _resultfile.FIELDS == tuple(f.name for f in dataclasses.fields(Result))
