@@ -7,10 +7,36 @@ previous run with the same options left there, records a case that raises as
 that case's failure and goes on, and on Ctrl-C cancels the rest, stops its own
 worker processes and raises :class:`Interrupted` (the command line prints one
 line and exits 130).
+
+Every study's ``run``
+---------------------
+Besides its own options, every study's ``run`` takes the sweep options
+
+``quick``
+    the test-suite mode: the study's ``QUICK`` defaults over its ``FULL`` ones;
+``out``
+    the output folder (default ``out/NAME``, ``out/NAME-quick`` with ``quick``),
+    checked before any work; each case is stored there when it finishes and a
+    rerun reuses the stored cases;
+``jobs``, ``executor``
+    worker processes, or any ``concurrent.futures.Executor`` (e.g. a Dask
+    ``Client().get_executor()``, which overrides ``jobs``), see :func:`run_cases`;
+``plots``
+    write the markdown table and the figures (PNG and SVG); with
+    ``plots=False`` and no ``out`` nothing is written;
+``progress``
+    a progress bar on stderr;
+
+and returns a dict with the study's own results (``rows``, ...) and the keys
+``errors`` (``{case label: error text}`` of the cases that raised),
+``reused`` (cases taken from ``out``), ``figures`` (``{file stem: Figure}``),
+``table`` (markdown) and ``path`` (the output folder or None). The command
+line (:mod:`ancfdae.studies._cli`) maps ``ancfdae study NAME`` onto ``run``.
 """
 from __future__ import annotations
 
 import json
+import math
 import multiprocessing
 import os
 import re
@@ -25,7 +51,7 @@ from pathlib import Path
 from ancfdae.result import Result
 
 __all__ = ["Case", "OptionError", "output_dir", "CaseStore", "Sweep", "Interrupted", "run_cases", "markdown_table",
-           "progress_bar", "settings"]
+           "cell", "errors_note", "progress_bar", "settings"]
 
 
 class OptionError(ValueError):
@@ -349,6 +375,18 @@ def markdown_table(headers, rows) -> str:
     lines = ["| " + " | ".join(headers) + " |", "|" + "---|" * len(headers)]
     lines += ["| " + " | ".join(fmt(x) for x in row) + " |" for row in rows]
     return "\n".join(lines) + "\n"
+
+
+def cell(x, spec: str = ".3g") -> str:
+    """A table cell: ``x`` formatted with ``spec``, or "-" when it is None or not finite."""
+    return "-" if x is None or (isinstance(x, float) and not math.isfinite(x)) else format(x, spec)
+
+
+def errors_note(errors: dict) -> str:
+    """The line under a study's table that names the cases that raised ("" when none did)."""
+    if not errors:
+        return ""
+    return "\nCases that raised (not in the table): " + "; ".join(f"{k}: {v}" for k, v in errors.items()) + "\n"
 
 
 def settings(full: dict, quick_defaults: dict, quick: bool, given: dict) -> dict:
