@@ -1,4 +1,4 @@
-"""Shared plumbing of the studies: output folder, the case runner that keeps every finished case, tables.
+"""Shared plumbing of the studies: options, output folder, and the case runner that keeps every finished case.
 
 A study is a sweep of independent cases (one simulation each). :func:`run_cases`
 runs them serially or through an executor, writes each finished case to the
@@ -30,13 +30,13 @@ Besides its own options, every study's ``run`` takes the sweep options
 and returns a dict with the study's own results (``rows``, ...) and the keys
 ``errors`` (``{case label: error text}`` of the cases that raised),
 ``reused`` (cases taken from ``out``), ``figures`` (``{file stem: Figure}``),
-``table`` (markdown) and ``path`` (the output folder or None). The command
-line (:mod:`ancfdae.studies._cli`) maps ``ancfdae study NAME`` onto ``run``.
+``table`` (markdown, :mod:`ancfdae.studies._tables`) and ``path`` (the output
+folder or None). The command line (:mod:`ancfdae.studies._cli`) maps
+``ancfdae study NAME`` onto ``run``.
 """
 from __future__ import annotations
 
 import json
-import math
 import multiprocessing
 import os
 import re
@@ -50,8 +50,8 @@ from pathlib import Path
 
 from ancfdae.result import Result
 
-__all__ = ["Case", "OptionError", "output_dir", "CaseStore", "Sweep", "Interrupted", "run_cases", "markdown_table",
-           "cell", "errors_note", "progress_bar", "settings"]
+__all__ = ["Case", "OptionError", "output_dir", "CaseStore", "Sweep", "Interrupted", "run_cases", "progress_bar",
+           "settings"]
 
 
 class OptionError(ValueError):
@@ -364,29 +364,6 @@ def _stop(pool) -> None:
     deadline = time.monotonic() + 5.0
     for p in procs:
         p.join(timeout=max(0.0, deadline - time.monotonic()))
-
-
-def markdown_table(headers, rows) -> str:
-    """A GitHub markdown table; floats printed with 4 significant digits."""
-    def fmt(x):
-        if isinstance(x, float):
-            return f"{x:.4g}" if 1e-3 <= abs(x) < 1e4 or x == 0 else f"{x:.3e}"
-        return str(x)
-    lines = ["| " + " | ".join(headers) + " |", "|" + "---|" * len(headers)]
-    lines += ["| " + " | ".join(fmt(x) for x in row) + " |" for row in rows]
-    return "\n".join(lines) + "\n"
-
-
-def cell(x, spec: str = ".3g") -> str:
-    """A table cell: ``x`` formatted with ``spec``, or "-" when it is None or not finite."""
-    return "-" if x is None or (isinstance(x, float) and not math.isfinite(x)) else format(x, spec)
-
-
-def errors_note(errors: dict) -> str:
-    """The line under a study's table that names the cases that raised ("" when none did)."""
-    if not errors:
-        return ""
-    return "\nCases that raised (not in the table): " + "; ".join(f"{k}: {v}" for k, v in errors.items()) + "\n"
 
 
 def settings(full: dict, quick_defaults: dict, quick: bool, given: dict) -> dict:

@@ -23,7 +23,8 @@ from ancfdae import models
 from ancfdae.result import Result
 
 from ._cli import Option, main as cli_main
-from ._common import Case, OptionError, errors_note, markdown_table, output_dir, run_cases, settings
+from ._common import Case, OptionError, output_dir, run_cases, settings
+from ._tables import errors_note, markdown_table
 
 __all__ = ["run", "run_case", "build", "solve_case", "ELEMENTS", "TABLE2", "REFERENCE", "FULL", "QUICK",
            "CLI_OPTIONS"]

@@ -24,7 +24,8 @@ import numpy as np
 from ancfdae.simulate import METHODS
 
 from ._cli import Option, main as cli_main
-from ._common import Case, OptionError, cell, errors_note, markdown_table, output_dir, run_cases, settings
+from ._common import Case, OptionError, output_dir, run_cases, settings
+from ._tables import cell, errors_note, markdown_table
 from ._flying import T_HAT, T_PULSE, available, b2_beam, b3_beam, simulate_case, steady_drift, unpack
 
 __all__ = ["run", "run_case", "INTEGRATORS", "FULL", "QUICK", "CLI_OPTIONS"]

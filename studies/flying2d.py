@@ -26,7 +26,8 @@ import sys
 import numpy as np
 
 from ._cli import Option, main as cli_main
-from ._common import OptionError, errors_note, markdown_table, output_dir, run_cases, settings
+from ._common import OptionError, output_dir, run_cases, settings
+from ._tables import errors_note, markdown_table
 from ._flying import FAMILY, Case, T_PULSE, available, b2_beam, eps_T, regress_order, simulate_case, steady_drift, \
     unpack
 

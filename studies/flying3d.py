@@ -42,7 +42,8 @@ import numpy as np
 from ancfdae.simulate import METHODS
 
 from ._cli import Option, main as cli_main
-from ._common import Case, OptionError, cell, errors_note, markdown_table, output_dir, run_cases, settings
+from ._common import Case, OptionError, output_dir, run_cases, settings
+from ._tables import cell, errors_note, markdown_table
 from ._flying import T_HAT, available, b3_beam, simulate_case, steady_drift, unpack
 
 __all__ = ["run", "run_case", "summarize", "UpdateAudit", "FULL", "QUICK", "CLI_OPTIONS", "CHAPTER_FAILURES"]

@@ -33,7 +33,8 @@ import numpy as np
 from ancfdae.simulate import METHODS as _AVAILABLE
 
 from ._cli import Option, main as cli_main
-from ._common import Case, OptionError, errors_note, markdown_table, output_dir, run_cases, settings
+from ._common import Case, OptionError, output_dir, run_cases, settings
+from ._tables import errors_note, markdown_table
 from ._flying import T_PULSE, b2_beam, eps_T, regress_order, simulate_case, steady_drift, unpack
 
 __all__ = ["run", "run_case", "METHODS", "FULL", "QUICK", "CLI_OPTIONS"]
