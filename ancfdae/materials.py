@@ -202,6 +202,9 @@ class Section(ABC):
 class RectangularSection(Section):
     """Rectangular cross-section, ``h`` along ``eta`` (e_y) and ``b`` along ``zeta`` (e_z).
 
+    ``J``, ``k_s``, ``shear_factors_of`` and ``k_t`` are those of every
+    :class:`Section`.
+
     Parameters
     ----------
     h, b : float
@@ -266,7 +269,8 @@ class CircularSection(Section):
     """Solid circular cross-section.
 
     ``k_t = 1`` (the polar moment is the torsion constant); the default shear
-    factor is ``6 (1 + nu) / (7 + 6 nu)`` (Cowper, solid circle).
+    factor is ``6 (1 + nu) / (7 + 6 nu)`` (Cowper, solid circle). ``J``,
+    ``k_s``, ``shear_factors_of`` and ``k_t`` are those of every :class:`Section`.
 
     Parameters
     ----------
