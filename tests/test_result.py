@@ -187,6 +187,11 @@ def test_damaged_content_is_a_clear_error(saved, tmp_path):
     ds.to_netcdf(tmp_path / "badattr.nc", engine="netcdf4")
     with pytest.raises(ResultFileError, match="badattr.nc.*'stats' is not JSON"):
         Result.load(tmp_path / "badattr.nc")
+    ds.attrs["stats"] = "{}"
+    ds.attrs["status"] = "converged"          # read fine, but Result refuses it: still a file error
+    ds.to_netcdf(tmp_path / "badstatus.nc", engine="netcdf4")
+    with pytest.raises(ResultFileError, match="badstatus.nc: damaged ancfdae result file: `status` must be one of"):
+        Result.load(tmp_path / "badstatus.nc")
 
 
 #: A result file written by the code before the result-file module stopped building Results itself
