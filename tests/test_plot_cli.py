@@ -103,8 +103,10 @@ def test_studies_missing_from_an_uninstalled_checkout_is_a_clear_exit(monkeypatc
         main(["study", "cantilever", "--quick"])
 
 
-def test_python_dash_m():
-    out = subprocess.run([sys.executable, "-m", "ancfdae", "--version"], capture_output=True, text=True, check=True)
+def test_python_dash_m(tmp_path):
+    # run outside the checkout, as a user would: -m puts the current folder first on sys.path
+    out = subprocess.run([sys.executable, "-m", "ancfdae", "--version"], capture_output=True, text=True, check=True,
+                         cwd=tmp_path)
     assert out.stdout.strip() == f"ancfdae {ancfdae.__version__}"
 
 

@@ -101,8 +101,10 @@ def _interrupt(tmp_path, jobs, how="ctrl-c"):
     args = [sys.executable, "-c", _CTRL_C, "--out", str(tmp_path), "--sleep", "0.1"]
     if jobs:
         args += ["--jobs", str(jobs)]
+    # cwd outside the checkout: `python -c` puts its folder first on sys.path, and a checkout's ancfdae,
+    # not installed, has no ancfdae.studies
     proc = subprocess.Popen(args, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)
+                            start_new_session=True, cwd=tmp_path)
     deadline = time.monotonic() + 120
     while len(list((tmp_path / "cases").glob("*.json"))) < 2:
         assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
@@ -137,7 +139,7 @@ def test_ctrl_c_stops_within_seconds_keeps_finished_cases_and_exits_130(tmp_path
     assert not any(_alive(pid) for pid in workers), "a worker outlived Ctrl-C"
     # the same command again reuses the two finished cases and runs the other two
     again = subprocess.run([sys.executable, "-c", _MAIN, "--out", str(tmp_path), "--sleep", "0.1"],
-                           env=dict(os.environ, PYTHONPATH=str(HERE)),
+                           env=dict(os.environ, PYTHONPATH=str(HERE)), cwd=tmp_path,
                            capture_output=True, text=True, timeout=120)
     assert again.returncode == 0 and "reusing 2 of 4 finished cases" in again.stderr, again.stderr
     assert "| case 3 | 9 |" in again.stdout
