@@ -9,7 +9,7 @@ Submodules: :mod:`ancfdae.models` (elements and the beam), :mod:`ancfdae.integra
 import logging
 
 from .loads import DistributedLoad, Gravity, PointForce, PointMoment, constant, hat, pulse, ramp
-from .materials import CircularSection, Material, RectangularSection, cowper_shear_factor
+from .materials import CircularSection, Material, RectangularSection, Section, cowper_shear_factor
 from .problem import Energy, JacobianBlocks, Model
 from .static import StaticResult, solve_static
 from .simulate import METHODS, simulate
@@ -23,7 +23,7 @@ __version__ = "0.1.0"
 logging.getLogger("ancfdae").addHandler(logging.NullHandler())
 
 __all__ = [
-    "Material", "RectangularSection", "CircularSection", "cowper_shear_factor",
+    "Material", "Section", "RectangularSection", "CircularSection", "cowper_shear_factor",
     "PointForce", "PointMoment", "Gravity", "DistributedLoad", "constant", "ramp", "pulse", "hat",
     "Model", "JacobianBlocks", "Energy",
     "solve_static", "StaticResult",

@@ -35,12 +35,18 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["ResultFileError", "FORMAT", "ENGINE", "describe_model", "to_dataset", "from_dataset", "save", "load"]
+__all__ = ["ResultFileError", "FORMAT", "ENGINE", "FIELDS", "describe_model", "to_dataset", "from_dataset", "write",
+           "read"]
 
 #: Format tag written into every result file.
 FORMAT = "ancfdae.Result/2"
 #: xarray engine used to write (see the module docstring for the measurement).
 ENGINE = "netcdf4"
+#: The fields of a result, as :func:`to_dataset` takes them and :func:`from_dataset` returns them
+#: (the attributes of :class:`ancfdae.Result`, which this module does not import: it reads and
+#: writes fields, and ``Result.load`` builds the object).
+FIELDS = ("t", "q", "v", "a", "status", "message", "stats", "monitors", "t_fail", "method", "options",
+          "model_state", "model")
 _SUFFIXES = (".nc", ".nc4", ".h5")
 _UNITS = ("The model's consistent unit system (the studies use SI: m, s, kg); coordinate units per `dof`: "
           "positions length, slope coordinates 1, theta rad.")
@@ -86,9 +92,9 @@ def describe_model(model) -> dict:
     return record
 
 
-def _dof_labels(result) -> tuple[np.ndarray, np.ndarray]:
-    n = result.q.shape[1]
-    labels = result.model.get("dof_labels") if result.model else None
+def _dof_labels(fields) -> tuple[np.ndarray, np.ndarray]:
+    n = fields["q"].shape[1]
+    labels = fields["model"].get("dof_labels") if fields["model"] else None
     if labels is not None and len(labels["node"]) == n:
         return np.asarray(labels["node"], dtype=np.int64), np.asarray(labels["coordinate"], dtype=str)
     return np.full(n, -1, dtype=np.int64), np.array([f"q{i}" for i in range(n)], dtype=str)
@@ -111,23 +117,26 @@ def _var_name(name: str, taken) -> str:
     return name
 
 
-def to_dataset(result):
-    """The :class:`xarray.Dataset` of a result (what :meth:`Result.save` writes).
+def to_dataset(fields):
+    """The :class:`xarray.Dataset` of a result's fields (what :meth:`Result.save` writes).
 
     Parameters
     ----------
-    result : Result
+    fields : mapping
+        ``{name: value}`` for every name of :data:`FIELDS`, as held by a
+        :class:`ancfdae.Result` (arrays time-major, ``stats``, ``options``
+        and ``model`` JSON-able).
 
     Returns
     -------
     xarray.Dataset
     """
-    import xarray as xr
-    n_t = result.t.size
-    node, coord = _dof_labels(result)
-    data = {name: (("time", "dof"), getattr(result, name)) for name in ("q", "v", "a")}
+    import xarray as xr     # imported on first use: it adds 1.5-2 s to `import ancfdae` (measured)
+    n_t = fields["t"].size
+    node, coord = _dof_labels(fields)
+    data = {name: (("time", "dof"), fields[name]) for name in ("q", "v", "a")}
     scalars: dict = {}
-    for name, log in result.monitors.items():
+    for name, log in fields["monitors"].items():
         scalars[name] = {}
         for key, value in log.items():
             if isinstance(value, np.ndarray):
@@ -135,15 +144,16 @@ def to_dataset(result):
                 data[var] = _array_var(var, value, n_t) + ({"monitor": name, "key": key},)
             else:
                 scalars[name][key] = value
-    for key, value in result.model_state.items():
+    for key, value in fields["model_state"].items():
         var = _var_name(f"state.{key}", data)
         data[var] = _array_var(var, value, n_t) + ({"state": key},)
-    model = dict(result.model or {})
+    model = dict(fields["model"] or {})
     model.pop("dof_labels", None)
+    t_fail = fields["t_fail"]
     attrs = {
-        "format": FORMAT, "status": result.status, "message": result.message, "method": result.method,
-        "t_fail": math.nan if result.t_fail is None else float(result.t_fail),
-        "stats": _dump(result.stats, "stats"), "options": _dump(result.options, "options"),
+        "format": FORMAT, "status": fields["status"], "message": fields["message"], "method": fields["method"],
+        "t_fail": math.nan if t_fail is None else float(t_fail),
+        "stats": _dump(fields["stats"], "stats"), "options": _dump(fields["options"], "options"),
         "monitor_scalars": _dump(scalars, "monitors"), "model": _dump(model, "model"), "unit_system": _UNITS,
     }
     for key in ("formulation",):
@@ -157,7 +167,7 @@ def to_dataset(result):
                                    {"long_name": "reference positions of the nodes (the dof coordinate 'node')"})
         data["element_nodes"] = (("element", "element_node"), np.asarray(model["element_nodes"], dtype=np.int64),
                                  {"long_name": "nodes of each element (3-node elements: start, end, middle)"})
-    ds = xr.Dataset(data, coords={"time": ("time", result.t), "node": ("dof", node),
+    ds = xr.Dataset(data, coords={"time": ("time", fields["t"]), "node": ("dof", node),
                                   "coordinate": ("dof", coord)}, attrs=attrs)
     ds["time"].attrs["long_name"] = "output time"
     for name, long in (("q", "coordinates"), ("v", "velocities"), ("a", "accelerations")):
@@ -170,8 +180,10 @@ def _path(path) -> Path:
     return path if path.suffix in _SUFFIXES else path.with_name(path.name + ".nc")
 
 
-def save(result, path, engine: str = ENGINE) -> Path:
-    """Write ``result`` to ``path`` (``.nc`` added unless it ends in .nc, .nc4 or .h5).
+def write(path, fields, engine: str = ENGINE) -> Path:
+    """Write a result's ``fields`` (see :func:`to_dataset`) to ``path``.
+
+    ``.nc`` is added unless ``path`` ends in .nc, .nc4 or .h5.
 
     Returns
     -------
@@ -179,7 +191,7 @@ def save(result, path, engine: str = ENGINE) -> Path:
         The path written.
     """
     path = _path(path)
-    ds = to_dataset(result)
+    ds = to_dataset(fields)
     # Strings as variable-length UTF-8; floats stored uncompressed so they come back bit for bit.
     ds.to_netcdf(path, engine=engine, format="NETCDF4")
     return path
@@ -200,15 +212,26 @@ def _loads(ds, key, path):
         raise ResultFileError(f"{path}: damaged ancfdae result file: attribute {key!r} is not JSON ({exc}).") from None
 
 
-def from_dataset(ds, path="<dataset>"):
-    """Rebuild a :class:`Result` from a dataset of :func:`to_dataset` (in memory).
+def from_dataset(ds, path="<dataset>") -> dict:
+    """The fields of a result from a dataset of :func:`to_dataset` (in memory).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+    path : str or path-like
+        Names the source in error messages.
+
+    Returns
+    -------
+    dict
+        ``{name: value}`` for every name of :data:`FIELDS`, to be checked
+        and held by :class:`ancfdae.Result`.
 
     Raises
     ------
     ResultFileError
         If a variable or attribute is missing or malformed.
     """
-    from .result import Result
     if ds.attrs.get("format") != FORMAT:
         raise ResultFileError(f"{path}: not an ancfdae result file (attribute 'format' is "
                               f"{ds.attrs.get('format')!r}, expected {FORMAT!r}).")
@@ -226,18 +249,14 @@ def from_dataset(ds, path="<dataset>"):
     if model and "node" in ds.coords:
         model["dof_labels"] = {"node": ds["node"].values.tolist(), "coordinate": ds["coordinate"].values.tolist()}
     t_fail = float(ds.attrs.get("t_fail", math.nan))
-    try:
-        return Result(t=t, q=arrays["q"], v=arrays["v"], a=arrays["a"], status=str(ds.attrs.get("status")),
-                      message=str(ds.attrs.get("message", "")), stats=_loads(ds, "stats", path),
-                      monitors=monitors, t_fail=None if math.isnan(t_fail) else t_fail,
-                      method=str(ds.attrs.get("method", "")), options=_loads(ds, "options", path),
-                      model_state=state, model=model)
-    except ValueError as exc:
-        raise ResultFileError(f"{path}: damaged ancfdae result file: {exc}") from None
+    return dict(t=t, q=arrays["q"], v=arrays["v"], a=arrays["a"], status=str(ds.attrs.get("status")),
+                message=str(ds.attrs.get("message", "")), stats=_loads(ds, "stats", path), monitors=monitors,
+                t_fail=None if math.isnan(t_fail) else t_fail, method=str(ds.attrs.get("method", "")),
+                options=_loads(ds, "options", path), model_state=state, model=model)
 
 
-def load(path):
-    """Read a result file written by :func:`save`.
+def read(path) -> dict:
+    """The fields of the result file ``path`` written by :func:`write` (see :func:`from_dataset`).
 
     Raises
     ------
@@ -245,7 +264,7 @@ def load(path):
         Naming the file: missing, not NetCDF4/HDF5 (or truncated), an old
         ``.npz`` result, or a NetCDF file that is not an ancfdae result.
     """
-    import xarray as xr
+    import xarray as xr     # on first use, as in to_dataset
     path = Path(path)
     if not path.is_file():
         raise ResultFileError(f"{path}: no such result file.")

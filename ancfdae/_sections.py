@@ -18,7 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["section_outline", "section_vectors", "solid_points", "reference_points", "wedge_cells"]
+__all__ = ["section_outline", "section_vectors", "output_directors", "solid_points", "reference_points",
+           "wedge_cells"]
 
 
 def section_outline(section, n_circle: int = 16) -> np.ndarray:
@@ -90,6 +91,27 @@ def section_vectors(beam, q: np.ndarray, directors: np.ndarray | None = None):
     e2_ref = beam.frames[:, :, 1]
     e2 = _unit(e2_ref - np.einsum("ni,ni->n", e2_ref, t)[:, None] * t)
     return r, e2, np.cross(t, e2)
+
+
+def output_directors(result, beam) -> np.ndarray | None:
+    """BE3D's nodal directors at each output of ``result``, shape (n_out, n_nodes, 3); None for other elements.
+
+    Taken from ``result.model_state["directors"]``; a BE3D beam without director updates keeps
+    its reference directors.
+
+    Raises
+    ------
+    ValueError
+        If a BE3D result with director updates does not carry them.
+    """
+    if beam.element.name != "BE3D":
+        return None
+    if "directors" in result.model_state:
+        return np.asarray(result.model_state["directors"], dtype=float)
+    if beam.element.director_update == "none":
+        return np.repeat(beam.geom["directors"][None], result.t.size, axis=0)
+    raise ValueError("`result` of a BE3D beam with director updates needs result.model_state['directors'] "
+                     "(the nodal directors at each output) to draw the cross-section frames.")
 
 
 def solid_points(beam, q: np.ndarray, outline: np.ndarray, directors=None) -> np.ndarray:

@@ -16,12 +16,31 @@ import argparse
 import importlib
 import pkgutil
 import sys
+from pathlib import Path
+
+from . import __version__
+from .export import vtk
+from .plot import animate
+from .result import Result, ResultFileError
 
 __all__ = ["main"]
 
 
+def _studies_package():
+    """``ancfdae.studies``, or a clear exit where the package was imported from a checkout not installed."""
+    try:
+        return importlib.import_module("ancfdae.studies")
+    except ModuleNotFoundError as exc:
+        if exc.name != "ancfdae.studies":
+            raise
+        # The studies folder becomes ancfdae.studies only by installation (pyproject's package-dir).
+        raise SystemExit(f"ancfdae: the studies are not importable: ancfdae was imported from "
+                         f"{Path(__file__).parent}, a source checkout that is not installed; run "
+                         "`pip install -e .` in it, or run from another folder.") from None
+
+
 def _studies() -> list[str]:
-    import ancfdae.studies as pkg
+    pkg = _studies_package()
     return sorted(m.name for m in pkgutil.iter_modules(pkg.__path__) if not m.name.startswith("_"))
 
 
@@ -33,7 +52,6 @@ def _load(name: str):
 
 
 def _load_result(path: str):
-    from ancfdae.result import Result, ResultFileError
     try:
         return Result.load(path)
     except ResultFileError as exc:
@@ -48,7 +66,6 @@ def _positive(text: str) -> int:
 
 
 def _export(args) -> int:
-    from ancfdae.export import vtk
     result = _load_result(args.result)
     try:
         pvd = vtk(result, None, args.directory, name=args.name, every=args.every)
@@ -59,7 +76,6 @@ def _export(args) -> int:
 
 
 def _animate(args) -> int:
-    from ancfdae.plot import animate
     result = _load_result(args.result)
     try:
         out = animate(result, args.output, every=args.every, fps=args.fps)
@@ -82,7 +98,6 @@ def main(argv: list[str] | None = None) -> int:
     int
         Exit status 0; errors exit through :class:`SystemExit` with a message.
     """
-    from ancfdae import __version__
     parser = argparse.ArgumentParser(prog="ancfdae", description="ANCF beam dynamics: studies, result files, "
                                      "ParaView export and animations.")
     parser.add_argument("--version", action="version", version=f"ancfdae {__version__}")
@@ -114,8 +129,9 @@ def main(argv: list[str] | None = None) -> int:
             doc = (_load(name).__doc__ or "").strip().splitlines()
             print(f"{name:14s} {doc[0] if doc else ''}")
         return 0
-    from ancfdae.studies import _cli
-    return _cli.main(_load(args.name), args.options, prog=f"ancfdae study {args.name}")
+    study = _load(args.name)
+    from ancfdae.studies import _cli     # importable once _load found the study
+    return _cli.main(study, args.options, prog=f"ancfdae study {args.name}")
 
 
 if __name__ == "__main__":

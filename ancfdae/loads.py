@@ -125,13 +125,20 @@ def _check_time(time):
     return time
 
 
-def _check_place(node, s):
+def _check_point(load) -> None:
+    """Check where a point load acts (exactly one of ``node`` and ``s``) and fill in its time function.
+
+    Shared by :class:`PointForce` and :class:`PointMoment` (frozen dataclasses: set through
+    ``object.__setattr__``).
+    """
+    node, s = load.node, load.s
     if (node is None) == (s is None):
         raise ValueError(f"give exactly one of `node` and `s`, got node={node!r}, s={s!r}.")
     if node is not None and (isinstance(node, bool) or not isinstance(node, numbers.Integral)):
         raise ValueError(f"`node` must be an integer node index, got {node!r}.")
     if s is not None and (isinstance(s, bool) or not isinstance(s, numbers.Real) or not np.isfinite(s)):
         raise ValueError(f"`s` must be a finite arc length, got {s!r}.")
+    object.__setattr__(load, "time", _check_time(load.time))
 
 
 @dataclass(frozen=True)
@@ -155,8 +162,7 @@ class PointForce:
 
     def __post_init__(self):
         object.__setattr__(self, "force", finite_vector("force", self.force))
-        _check_place(self.node, self.s)
-        object.__setattr__(self, "time", _check_time(self.time))
+        _check_point(self)
 
 
 @dataclass(frozen=True)
@@ -188,8 +194,7 @@ class PointMoment:
             raise ValueError(f"`moment` must be a scalar (2D) or a 3-vector, got {self.moment!r}.")
         finite_vector("moment", m)
         object.__setattr__(self, "moment", m)
-        _check_place(self.node, self.s)
-        object.__setattr__(self, "time", _check_time(self.time))
+        _check_point(self)
 
     def vector3(self) -> np.ndarray:
         """The moment as a 3-vector (a scalar is about e_z)."""

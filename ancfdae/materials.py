@@ -10,13 +10,14 @@ from __future__ import annotations
 
 import math
 import numbers
-from dataclasses import dataclass, field
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
 
 import numpy as np
 
 from ._validate import positive
 
-__all__ = ["Material", "RectangularSection", "CircularSection", "cowper_shear_factor"]
+__all__ = ["Material", "Section", "RectangularSection", "CircularSection", "cowper_shear_factor"]
 
 
 def cowper_shear_factor(nu: float) -> float:
@@ -70,35 +71,6 @@ class Material:
         return self.E / (2.0 * (1.0 + self.nu))
 
 
-def _check_factors(section) -> None:
-    """Validate ``shear_factor``, ``torsion_factor`` and ``shear_factors`` of a section (frozen dataclass)."""
-    for name in ("shear_factor", "torsion_factor"):   # stored as floats (numpy scalars are numbers)
-        value = getattr(section, name)
-        if value is not None:
-            object.__setattr__(section, name, positive(name, value))
-    pair = section.shear_factors
-    if pair is None:
-        return
-    if section.shear_factor is not None:
-        raise ValueError("give either `shear_factor` (k2 = k3) or `shear_factors` (k2, k3), not both; got "
-                         f"shear_factor={section.shear_factor!r}, shear_factors={pair!r}.")
-    if isinstance(pair, (str, bytes)) or not hasattr(pair, "__len__") or len(pair) != 2:
-        raise ValueError(f"`shear_factors` must be a pair (k2, k3) of positive numbers, got {pair!r}.")
-    object.__setattr__(section, "shear_factors",
-                       (positive("shear_factors[0]", pair[0]), positive("shear_factors[1]", pair[1])))
-
-
-def _common_shear_factor(section, default: float) -> float:
-    """``k_s`` when k2 = k3; a clear error when the section has two different factors."""
-    if section.shear_factors is not None:
-        k2, k3 = section.shear_factors
-        if k2 != k3:
-            raise ValueError(f"this section has two shear factors, shear_factors={section.shear_factors!r}; "
-                             "use `shear_factors_of(material)` instead of `k_s`.")
-        return k2
-    return section.shear_factor if section.shear_factor is not None else default
-
-
 def _saint_venant_rectangle(h: float, b: float, terms: int = 50) -> float:
     """Saint-Venant torsion constant of an h x b rectangle (series solution)."""
     long, short = max(h, b), min(h, b)
@@ -106,9 +78,132 @@ def _saint_venant_rectangle(h: float, b: float, terms: int = 50) -> float:
     return long * short**3 / 3.0 * (1.0 - 192.0 / math.pi**5 * short / long * s)
 
 
+class Section(ABC):
+    """A cross-section: what every shape shares, the polar moment and the shear and torsion factors.
+
+    A shape is a frozen dataclass subclass that declares its dimensions and
+    the three factor fields ``shear_factor``, ``torsion_factor`` and
+    ``shear_factors`` (each None by default), and defines the area ``A``,
+    the moments ``I2``, ``I3``, ``I4`` (chapter Eq. 42, Eq. 85),
+    ``_check_dimensions()`` and its default factors
+    ``_default_shear_factor(nu)`` and ``_default_torsion_factor()``:
+    :class:`RectangularSection` and :class:`CircularSection` are the two
+    shapes of the package. The factor fields are checked here once for
+    every shape (positive; a pair ``(k2, k3)`` or one ``k_s``, not both).
+    """
+
+    shear_factor: float | None
+    torsion_factor: float | None
+    shear_factors: tuple | None
+
+    def __post_init__(self):
+        self._check_dimensions()
+        for name in ("shear_factor", "torsion_factor"):   # stored as floats (numpy scalars are numbers)
+            value = getattr(self, name)
+            if value is not None:
+                object.__setattr__(self, name, positive(name, value))
+        pair = self.shear_factors
+        if pair is None:
+            return
+        if self.shear_factor is not None:
+            raise ValueError("give either `shear_factor` (k2 = k3) or `shear_factors` (k2, k3), not both; got "
+                             f"shear_factor={self.shear_factor!r}, shear_factors={pair!r}.")
+        if isinstance(pair, (str, bytes)) or not hasattr(pair, "__len__") or len(pair) != 2:
+            raise ValueError(f"`shear_factors` must be a pair (k2, k3) of positive numbers, got {pair!r}.")
+        object.__setattr__(self, "shear_factors",
+                           (positive("shear_factors[0]", pair[0]), positive("shear_factors[1]", pair[1])))
+
+    @property
+    @abstractmethod
+    def A(self) -> float:
+        """Area."""
+
+    @property
+    @abstractmethod
+    def I2(self) -> float:
+        """``int zeta^2 dA`` (bending out of the x-y plane)."""
+
+    @property
+    @abstractmethod
+    def I3(self) -> float:
+        """``int eta^2 dA`` (bending in the x-y plane)."""
+
+    @property
+    @abstractmethod
+    def I4(self) -> float:
+        """``int eta^4 dA`` (enters the SVK bending moment, chapter Eq. 85)."""
+
+    @abstractmethod
+    def _check_dimensions(self) -> None:
+        """Check (and store as floats) the shape's dimensions."""
+
+    @abstractmethod
+    def _default_shear_factor(self, nu: float) -> float:
+        """``k_s`` of the shape when none is given (Cowper's for the package's shapes)."""
+
+    @abstractmethod
+    def _default_torsion_factor(self) -> float:
+        """``k_t`` of the shape when none is given: its torsion constant over ``J``."""
+
+    @property
+    def J(self) -> float:
+        """Polar moment ``I2 + I3``."""
+        return self.I2 + self.I3
+
+    def k_s(self, material: Material) -> float:
+        """The common shear correction factor ``k2 = k3`` (the shape's default when none is given).
+
+        Parameters
+        ----------
+        material : Material
+            Its ``nu`` enters the default (Cowper's) factor.
+
+        Returns
+        -------
+        float
+
+        Raises
+        ------
+        ValueError
+            If the section has two different factors ``shear_factors``; use
+            :meth:`shear_factors_of` then.
+        """
+        if self.shear_factors is not None:
+            k2, k3 = self.shear_factors
+            if k2 != k3:
+                raise ValueError(f"this section has two shear factors, shear_factors={self.shear_factors!r}; "
+                                 "use `shear_factors_of(material)` instead of `k_s`.")
+            return k2
+        return self.shear_factor if self.shear_factor is not None else self._default_shear_factor(material.nu)
+
+    def shear_factors_of(self, material: Material) -> tuple[float, float]:
+        """``(k2, k3)``: the shear factors along ``eta`` and ``zeta`` (chapter Eq. 42).
+
+        Parameters
+        ----------
+        material : Material
+
+        Returns
+        -------
+        (float, float)
+        """
+        if self.shear_factors is not None:
+            return self.shear_factors
+        k = self.k_s(material)
+        return k, k
+
+    @property
+    def k_t(self) -> float:
+        """Torsion factor ``k_t``: the torsional rigidity is ``G J k_t`` (the shape's default when none is given)."""
+        return self.torsion_factor if self.torsion_factor is not None else self._default_torsion_factor()
+
+
 @dataclass(frozen=True)
-class RectangularSection:
+class RectangularSection(Section):
     """Rectangular cross-section, ``h`` along ``eta`` (e_y) and ``b`` along ``zeta`` (e_z).
+
+    ``J``, ``k_s``, ``shear_factors_of`` and ``k_t`` are those of every
+    :class:`Section`.
 
     Parameters
     ----------
@@ -136,12 +231,11 @@ class RectangularSection:
     torsion_factor: float | None = None
     shear_factors: tuple | None = None
 
-    def __post_init__(self):
+    def _check_dimensions(self) -> None:
         object.__setattr__(self, "h", positive("h", self.h))
         if self.b is None:
             object.__setattr__(self, "b", self.h)
         object.__setattr__(self, "b", positive("b", self.b))
-        _check_factors(self)
 
     @property
     def A(self) -> float:
@@ -163,36 +257,20 @@ class RectangularSection:
         """``int eta^4 dA = b h^5 / 80`` (enters the SVK bending moment, chapter Eq. 85)."""
         return self.b * self.h**5 / 80.0
 
-    @property
-    def J(self) -> float:
-        """Polar moment ``I2 + I3``."""
-        return self.I2 + self.I3
+    def _default_shear_factor(self, nu: float) -> float:
+        return cowper_shear_factor(nu)
 
-    def k_s(self, material: Material) -> float:
-        """The common shear correction factor (Cowper's by default); see :meth:`shear_factors_of`."""
-        return _common_shear_factor(self, cowper_shear_factor(material.nu))
-
-    def shear_factors_of(self, material: Material) -> tuple[float, float]:
-        """``(k2, k3)``: the shear factors along ``eta`` and ``zeta`` (chapter Eq. 42)."""
-        if self.shear_factors is not None:
-            return self.shear_factors
-        k = self.k_s(material)
-        return k, k
-
-    @property
-    def k_t(self) -> float:
-        """Torsion factor: Saint-Venant torsion constant over ``J``."""
-        if self.torsion_factor is not None:
-            return self.torsion_factor
+    def _default_torsion_factor(self) -> float:
         return _saint_venant_rectangle(self.h, self.b) / self.J
 
 
 @dataclass(frozen=True)
-class CircularSection:
+class CircularSection(Section):
     """Solid circular cross-section.
 
     ``k_t = 1`` (the polar moment is the torsion constant); the default shear
-    factor is ``6 (1 + nu) / (7 + 6 nu)`` (Cowper, solid circle).
+    factor is ``6 (1 + nu) / (7 + 6 nu)`` (Cowper, solid circle). ``J``,
+    ``k_s``, ``shear_factors_of`` and ``k_t`` are those of every :class:`Section`.
 
     Parameters
     ----------
@@ -212,9 +290,8 @@ class CircularSection:
     torsion_factor: float | None = None
     shear_factors: tuple | None = None
 
-    def __post_init__(self):
+    def _check_dimensions(self) -> None:
         object.__setattr__(self, "d", positive("d", self.d))
-        _check_factors(self)
 
     @property
     def A(self) -> float:
@@ -236,33 +313,8 @@ class CircularSection:
         """``int eta^4 dA = pi d^6 / 512``."""
         return math.pi * self.d**6 / 512.0
 
-    @property
-    def J(self) -> float:
-        """Polar moment ``I2 + I3``."""
-        return self.I2 + self.I3
+    def _default_shear_factor(self, nu: float) -> float:
+        return 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu)      # Cowper, solid circle
 
-    def k_s(self, material: Material) -> float:
-        """The common shear correction factor (Cowper's for a solid circle by default).
-
-        Parameters
-        ----------
-        material : Material
-            Its ``nu`` enters Cowper's factor.
-
-        Returns
-        -------
-        float
-        """
-        return _common_shear_factor(self, 6.0 * (1.0 + material.nu) / (7.0 + 6.0 * material.nu))
-
-    def shear_factors_of(self, material: Material) -> tuple[float, float]:
-        """``(k2, k3)``: the shear factors along ``eta`` and ``zeta`` (chapter Eq. 42)."""
-        if self.shear_factors is not None:
-            return self.shear_factors
-        k = self.k_s(material)
-        return k, k
-
-    @property
-    def k_t(self) -> float:
-        """Torsion factor: 1 for a solid circle (the polar moment is the torsion constant)."""
-        return 1.0 if self.torsion_factor is None else self.torsion_factor
+    def _default_torsion_factor(self) -> float:
+        return 1.0      # the polar moment is the torsion constant of a solid circle

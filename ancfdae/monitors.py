@@ -27,7 +27,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ancfdae import _validate as V
+from ancfdae import _validate as validate
 
 __all__ = ["Monitor", "EnergyMonitor", "PointSensor", "Probe"]
 
@@ -56,8 +56,8 @@ class Monitor:
         t : float
         q, v, a : ndarray, shape (n_dof,)
             State at the end of the step.
-        nodes : tuple, optional
-            ``(ts, Q, V, w)``: the step's quadrature (times, stage coordinates
+        nodes : Quadrature, optional
+            ``(t, q, v, w)``: the step's quadrature (node times, coordinates
             and velocities as rows, weights summing to the step size).
         """
 
@@ -132,7 +132,7 @@ class EnergyMonitor(Monitor):
 
     def __init__(self, name: str = "energy", blowup: float = 0.1, stop_on_blowup: bool = False) -> None:
         self.name = str(name)
-        self.blowup = V.positive("blowup", blowup)
+        self.blowup = validate.positive("blowup", blowup)
         if not isinstance(stop_on_blowup, bool):
             raise ValueError(f"`stop_on_blowup` must be True or False, got {stop_on_blowup!r}.")
         self.stop_on_blowup = stop_on_blowup
@@ -157,8 +157,7 @@ class EnergyMonitor(Monitor):
         if nodes is None:
             dw = 0.5 * (t - self._t_cur) * (self._p_cur + p_end)
         else:
-            ts, Q, Vs, w = nodes
-            dw = sum(wj * float(self.model.external_power(tj, Qj, Vj)) for tj, Qj, Vj, wj in zip(ts, Q, Vs, w))
+            dw = sum(wj * float(self.model.external_power(tj, qj, vj)) for tj, qj, vj, wj in zip(*nodes))
         self._t_prev, self._w_prev = self._t_cur, self._w_cur
         self._t_cur, self._w_cur, self._p_cur = float(t), self._w_cur + dw, p_end
 
@@ -222,7 +221,7 @@ class PointSensor(Monitor):
             raise ValueError("PointSensor needs exactly one of `s` (arc length) or `function`, "
                              f"got s={s!r}, function={function!r}.")
         if s is not None:
-            s = V.nonnegative("s", s)
+            s = validate.nonnegative("s", s)
         if function is not None and not callable(function):
             raise ValueError(f"`function` must be callable, got {function!r}.")
         if velocity_function is not None and not callable(velocity_function):

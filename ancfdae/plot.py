@@ -17,7 +17,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._sections import section_outline, section_vectors
+from ._sections import output_directors, section_outline, section_vectors
+from .export import beam_of
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -33,7 +34,7 @@ _AXIS_SAMPLES = 8   # axis points drawn per element (the interpolation between n
 
 
 def _new_axes(three_d: bool):
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt      # on first use: pyplot takes 2.5-3 s to import (measured)
     fig = plt.figure()
     return fig.add_subplot(projection="3d" if three_d else None)
 
@@ -156,7 +157,6 @@ def tip(result: Result, ax: Axes | None = None, *, beam: Beam | None = None, s: 
     matplotlib Axes
         One line per component ``u_x, u_y(, u_z)``.
     """
-    from .export import beam_of
     if beam is None:
         beam = beam_of(result)
     s = beam.s_nodes[-1] if s is None else float(s)
@@ -197,11 +197,10 @@ def animate(result: Result, path: str | os.PathLike, *, beam: Beam | None = None
     pathlib.Path
         The file written. Frames share fixed axis limits (those of the whole motion).
     """
-    from matplotlib.animation import PillowWriter
+    from matplotlib.animation import PillowWriter       # matplotlib on first use, as in _new_axes
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from .export import _directors, beam_of
     if beam is None:
         beam = beam_of(result)
     if isinstance(every, bool) or not isinstance(every, int) or every < 1:
@@ -209,7 +208,7 @@ def animate(result: Result, path: str | os.PathLike, *, beam: Beam | None = None
     if result.t.size == 0:
         raise ValueError("`result` has no outputs to animate.")
     path = Path(path)
-    directors = _directors(result, beam)
+    directors = output_directors(result, beam)
     frames = range(0, result.t.size, every)
     fig = Figure(figsize=(6, 4))
     FigureCanvasAgg(fig)     # off-screen rendering, whatever backend pyplot uses

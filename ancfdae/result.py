@@ -7,7 +7,7 @@ and which keeps every output sample up to the failure.
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING
 from pathlib import Path
 
@@ -105,7 +105,11 @@ class Result:
         return (f"Result(method={self.method!r}, status={self.status!r}, n_out={self.t.size}, "
                 f"n_dof={n_dof}, t={span}, message={self.message!r})")
 
-    # -- persistence ------------------------------------------------------------------------
+    # -- persistence: the result-file module reads and writes the fields; the object is built here
+    def _fields(self) -> dict:
+        """``{name: value}`` of every field (no copies), as :mod:`ancfdae._resultfile` takes them."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
     def to_xarray(self) -> "xarray.Dataset":
         """The result as a labelled :class:`xarray.Dataset` (what :meth:`save` writes).
 
@@ -114,7 +118,7 @@ class Result:
         itself; monitors and ``model_state`` arrays as variables; status,
         message, stats, options and the model description as attributes.
         """
-        return _resultfile.to_dataset(self)
+        return _resultfile.to_dataset(self._fields())
 
     def save(self, path: str | os.PathLike, engine: str = _resultfile.ENGINE) -> Path:
         """Write a self-describing NetCDF4/HDF5 file, readable by plain xarray or h5py.
@@ -132,7 +136,7 @@ class Result:
         pathlib.Path
             The file written. Arrays round-trip bit for bit.
         """
-        return _resultfile.save(self, path, engine)
+        return _resultfile.write(path, self._fields(), engine)
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> "Result":
@@ -145,4 +149,8 @@ class Result:
             not NetCDF4/HDF5, truncated or damaged, an old ``.npz`` result, or
             not an ancfdae result.
         """
-        return _resultfile.load(path)
+        stored = _resultfile.read(path)
+        try:
+            return cls(**stored)
+        except ValueError as exc:   # the fields read, but do not make a Result (e.g. q of the wrong length)
+            raise ResultFileError(f"{Path(path)}: damaged ancfdae result file: {exc}") from None

@@ -33,13 +33,12 @@ the 2-norm/max-norm factor).
 """
 from __future__ import annotations
 
-import time
-
 import numpy as np
 
 from ancfdae._validate import positive_int
 
-from ._exudyn_base import _base_settings, _exu, _fix, _ground_marker, _ii, _require, available, module_variant
+from ._exudyn_base import (_base_settings, _exu, _fix, _ground_marker, _ii, _require, available, module_variant,
+                           square_section, timed_solves)
 from ._exudyn_pendulum import PENDULUM, pendulum
 
 __all__ = ["available", "module_variant", "cantilever_be2d", "cantilever_beam3d", "cantilever_ge3d",
@@ -131,15 +130,7 @@ def _build_b1_beam3d(n):
 
 def _section_b1():
     """B1's section for Exudyn's 3D beams: diag(EA, k_s GA, k_s GA, k_t G J, E I2, E I3) (chapter Eq. 112)."""
-    a, E, nu, rho = B1["a"], B1["E"], B1["nu"], B1["rho"]
-    G = E / (2 * (1 + nu))
-    ks = 10 * (1 + nu) / (12 + 11 * nu)
-    A, I = a**2, a**4 / 12
-    sec = _exu.BeamSection()
-    sec.stiffnessMatrix = np.diag([E * A, ks * G * A, ks * G * A, _K_TORSION * G * 2 * I, E * I, E * I])
-    sec.massPerLength = rho * A
-    sec.inertia = rho * np.diag([2 * I, I, I])
-    return sec
+    return square_section(B1["E"], B1["nu"], B1["rho"], B1["a"], _K_TORSION)
 
 
 def _build_b1_ge3d(n):
@@ -204,25 +195,16 @@ def _cantilever(build, n_elements, repeats, reference, criterion="ours"):
     n = positive_int("n_elements", n_elements)
     repeats = positive_int("repeats", repeats)
     _require()
-    walls, cpus, its, jacs = [], [], [], []
-    for _ in range(repeats):
-        SC, mbs, tip = build(n)  # fresh model per repeat, built untimed; SC owns mbs, keep it alive
-        settings = _static_settings(criterion)
-        solver = _exu.MainSolverStatic()
-        c0, t0 = time.process_time(), time.perf_counter()
-        ok = solver.SolveSystem(mbs, settings)
-        walls.append(time.perf_counter() - t0)
-        cpus.append(time.process_time() - c0)
-        if not ok:
-            raise RuntimeError(f"Exudyn static solver failed for B1 with {n} elements")
-        its.append(solver.it.newtonStepsCount)
-        jacs.append(solver.it.newtonJacobiCount)
-        u = np.asarray(mbs.GetNodeOutput(tip, _exu.OutputVariableType.Displacement))[:2]
+    (SC, mbs, tip), solver, walls, cpus = timed_solves(
+        lambda: build(n), lambda: _static_settings(criterion), _exu.MainSolverStatic, repeats,
+        f"Exudyn static solver failed for B1 with {n} elements")
+    u = np.asarray(mbs.GetNodeOutput(tip, _exu.OutputVariableType.Displacement))[:2]
     ref = np.asarray(reference)
     err = float(np.linalg.norm(u - ref))
     return dict(tip=(float(u[0]), float(u[1])), error=err, rel_error=err / float(np.linalg.norm(ref)),
-                wall_median=float(np.median(walls)), walls=walls, cpu_median=float(np.median(cpus)), newton_iterations=its[-1],
-                jacobians=jacs[-1], n_dof=int(mbs.systemData.ODE2Size()))
+                wall_median=float(np.median(walls)), walls=walls, cpu_median=float(np.median(cpus)),
+                newton_iterations=solver.it.newtonStepsCount, jacobians=solver.it.newtonJacobiCount,
+                n_dof=int(mbs.systemData.ODE2Size()))
 
 
 def cantilever_be2d(n_elements, repeats=3, criterion="ours"):

@@ -5,15 +5,13 @@ own strain measures and quadrature so that its conservation can be compared with
 """
 from __future__ import annotations
 
-import time
-
 import numpy as np
 
 from ancfdae._validate import choice, positive, positive_int
 from ancfdae.models._quadrature import gauss_for_order
 from ancfdae.models._shapes import hermite
 
-from ._exudyn_base import _base_settings, _exu, _fix, _ground_marker, _ii, _require
+from ._exudyn_base import _base_settings, _exu, _fix, _ground_marker, _ii, _require, timed_solves
 
 __all__ = ["pendulum", "PENDULUM"]
 
@@ -171,18 +169,11 @@ def pendulum(n_elements, integrator="trapezoidal", free=False, t_end=3.0, h=1e-4
     p = PENDULUM
     g = 0.0 if free else p["g"]
     le = p["L"] / n
-    walls, cpus = [], []
-    for _ in range(repeats):
-        # SC owns mbs: keep the reference alive while mbs is used
-        SC, mbs, nodes, tip, state_sensors = _build_pendulum(n, free, output_period, energy_history)
-        settings = _dynamic_settings(t_end, h, integrator, output_period, newton_tol)
-        solver = _exu.MainSolverImplicitSecondOrder()
-        c0, t0 = time.process_time(), time.perf_counter()
-        ok = solver.SolveSystem(mbs, settings)
-        walls.append(time.perf_counter() - t0)
-        cpus.append(time.process_time() - c0)
-        if not ok:
-            raise RuntimeError(f"Exudyn {integrator} failed for the {'free' if free else 'hinged'} beam")
+    (SC, mbs, nodes, tip, state_sensors), solver, walls, cpus = timed_solves(
+        lambda: _build_pendulum(n, free, output_period, energy_history),
+        lambda: _dynamic_settings(t_end, h, integrator, output_period, newton_tol),
+        _exu.MainSolverImplicitSecondOrder, repeats,
+        f"Exudyn {integrator} failed for the {'free' if free else 'hinged'} beam")
     it = solver.it
     steps = int(it.currentStepIndex) - 1  # the index ends one past the last step taken
     wall = float(np.median(walls))

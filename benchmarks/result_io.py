@@ -30,7 +30,7 @@ def read_with(path: Path, engine: str) -> Result:
     import xarray as xr
     with xr.open_dataset(path, engine=engine) as ds:
         ds.load()
-        return _resultfile.from_dataset(ds, path)
+        return Result(**_resultfile.from_dataset(ds, path))
 
 
 def main(n_out: int = 10_000, n_dof: int = 200, repeats: int = 5) -> None:

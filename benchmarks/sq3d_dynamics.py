@@ -15,7 +15,7 @@ The two codes discretise different beam theories, so each is measured against a 
 of its own (its finest step, ``--ref-factor`` times smaller than the finest sampled one): error = max
 over the output times (every 10 ms) of the tip distance to that reference. CPU = process time of the
 solve, models built untimed, medians of ``--repeats`` interleaved rounds. Printed: every run, then the
-equal-accuracy ratios of :mod:`benchmarks.work_precision`.
+equal-accuracy ratios of :mod:`benchmarks._equal_accuracy`.
 
 Open (first run, 16 elements): the printed distance between our reference and Exudyn's trapezoidal
 reference was 0.43 m, far above the few mm the two codes' tips differed by at t = 0.5 s in a
@@ -32,8 +32,8 @@ import numpy as np
 from ancfdae import Material, RectangularSection, simulate
 from ancfdae.models import SQ3D, Beam
 
-from . import work_precision as wp
-from ._exudyn_base import _base_settings, _exu, _ii, available
+from . import _equal_accuracy as equal
+from ._exudyn_base import _base_settings, _exu, _ii, available, square_section, timed_solves
 
 MATERIAL = dict(E=2.1e10, nu=0.3, rho=4000.0)
 SIDE = 0.05
@@ -66,12 +66,7 @@ def run_ours(n, method, h, t_end, tol):
 
 
 def _build_peer(n):
-    E, nu, rho, a = MATERIAL["E"], MATERIAL["nu"], MATERIAL["rho"], SIDE
-    G, ks, A, I = E / (2 * (1 + nu)), 10 * (1 + nu) / (12 + 11 * nu), a * a, a**4 / 12
-    sec = _exu.BeamSection()
-    sec.stiffnessMatrix = np.diag([E * A, ks * G * A, ks * G * A, K_TORSION * G * 2 * I, E * I, E * I])
-    sec.massPerLength = rho * A
-    sec.inertia = rho * np.diag([2 * I, I, I])
+    sec = square_section(MATERIAL["E"], MATERIAL["nu"], MATERIAL["rho"], SIDE, K_TORSION)
     SC = _exu.SystemContainer()
     mbs = SC.AddSystem()
     le = 1.0 / n
@@ -89,9 +84,7 @@ def _build_peer(n):
     return SC, mbs, tip
 
 
-def run_peer(n, integrator, h, t_end, tol):
-    """One timed Exudyn run (ObjectBeamGeometricallyExact, modified Newton, adaptive step off)."""
-    SC, mbs, tip = _build_peer(n)   # SC owns mbs: keep it alive
+def _peer_settings(integrator, h, t_end, tol):
     s = _base_settings()
     ti = s.timeIntegration
     ti.numberOfSteps, ti.endTime = int(round(t_end / h)), t_end
@@ -103,17 +96,15 @@ def run_peer(n, integrator, h, t_end, tol):
     else:
         ga.useNewmark, ga.useIndex2Constraints, ga.spectralRadius = False, False, 0.8
     s.solution.sensors.writePeriod = DT_OUT
-    solver = _exu.MainSolverImplicitSecondOrder()
-    c0 = time.process_time()
-    ok = solver.SolveSystem(mbs, s)
-    cpu = time.process_time() - c0
+    return s
+
+
+def run_peer(n, integrator, h, t_end, tol):
+    """One timed Exudyn run (ObjectBeamGeometricallyExact, modified Newton, adaptive step off)."""
+    (SC, mbs, tip), _, _, cpus = timed_solves(lambda: _build_peer(n), lambda: _peer_settings(integrator, h, t_end, tol),
+                                              _exu.MainSolverImplicitSecondOrder, 1, "SolveSystem failed")
     d = np.asarray(mbs.GetSensorStoredData(tip))
-    return dict(cpu=cpu, tip=d[:, 1:4], t=d[:, 0], ok=bool(ok), message="" if ok else "SolveSystem failed")
-
-
-def _error(run, ref):
-    tip = np.column_stack([np.interp(ref["t"], run["t"], run["tip"][:, k]) for k in range(3)])
-    return float(np.max(np.linalg.norm(tip - ref["tip"], axis=1)))
+    return dict(cpu=cpus[0], tip=d[:, 1:4], t=d[:, 0], ok=True, message="")
 
 
 def case(n, t_end, repeats, tol, ref_factor):
@@ -124,30 +115,20 @@ def case(n, t_end, repeats, tol, ref_factor):
           f"tol {tol}; references: each method's step / {ref_factor:g} below its finest", flush=True)
     configs = [("ours", m, h) for m, hs in OURS.items() for h in hs]
     configs += [("exudyn", m, h) for m, hs in PEER.items() for h in hs]
-    runs, failed = {c: [] for c in configs}, set()
-    for _ in range(repeats):
-        for c in configs:
-            if c in failed:
-                continue
-            r = run_ours(n, c[1], c[2], t_end, tol) if c[0] == "ours" else run_peer(n, c[1], c[2], t_end, tol)
-            if not r["ok"]:
-                failed.add(c)
-                print(f"  {c[0]} {c[1]} {c[2]:g}: failed ({r['message']})", flush=True)
-                continue
-            runs[c].append(r)
-    rows = []
-    print(f"{'side':<7}{'method':<19}{'h':>10}{'CPU s':>9}{'error m':>10}")
-    for c in configs:
-        if c in failed or not runs[c]:
-            continue
-        cpu = float(np.median([r["cpu"] for r in runs[c]]))
-        err = _error(runs[c][-1], refs["ours"] if c[0] == "ours" else refs[("exudyn", c[1])])
-        rows.append((c, cpu, err))
-        print(f"{c[0]:<7}{c[1]:<19}{c[2]:>10.1e}{cpu:9.3f}{err:10.2e}", flush=True)
-    d = _error(refs[("exudyn", "trapezoidal")], refs["ours"])
+
+    def run(side, method, h):
+        return run_ours(n, method, h, t_end, tol) if side == "ours" else run_peer(n, method, h, t_end, tol)
+
+    def error(config, r):        # each side against its own reference (two beam theories)
+        ref = refs["ours"] if config[0] == "ours" else refs[("exudyn", config[1])]
+        return equal.tip_error(r, ref["t"], ref["tip"])
+
+    rows = equal.table(equal.interleaved(configs, run, repeats), error)
+    ref = refs["ours"]
+    d = equal.tip_error(refs[("exudyn", "trapezoidal")], ref["t"], ref["tip"])
     print(f"(model difference: the two references' tips differ by up to {d:.1e} m)")
-    wp.summary(rows)
-    wp.per_method(rows)
+    equal.summary(rows)
+    equal.per_method(rows)
     return rows
 
 

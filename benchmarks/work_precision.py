@@ -26,10 +26,8 @@ The definitions differ (Exudyn: 2-norm, reference residual adapted): say so when
 Printed: every run (method, step or rtol, CPU s, error, Newton iterations per step, factorisations),
 then at each accuracy level reached by an Exudyn run the cheapest run of each side at least as
 accurate and the ratio ours / Exudyn's best (< 1: ours faster), then for every run of ours the
-cheapest Exudyn run at least as accurate and the ratio (the per-method figure, e.g. for IDA). "Cheapest run at least as
-accurate" is a step function of the sampled step sizes: it favours neither side systematically but
-is coarse, so the ratio is also given with our cost interpolated (log-log, between the two runs of
-one method that bracket the level); the per-run table is the full picture.
+cheapest Exudyn run at least as accurate and the ratio (the per-method figure, e.g. for IDA); how
+these ratios are formed: :mod:`benchmarks._equal_accuracy`. The per-run table is the full picture.
 """
 from __future__ import annotations
 
@@ -40,6 +38,7 @@ import numpy as np
 
 from ancfdae import simulate
 
+from . import _equal_accuracy as equal
 from .dynamics import pendulum as build_pendulum
 
 try:
@@ -97,16 +96,11 @@ def run_peer(n, integrator, h, t_end, tol):
                 lu=r["jacobians"], message="")
 
 
-def _error(run, t_ref, tip_ref):
-    tip = np.column_stack([np.interp(t_ref, run["t"], run["tip"][:, k]) for k in range(2)])
-    return float(np.max(np.linalg.norm(tip - tip_ref, axis=1)))
-
-
 def reference(n, t_end, h_ref):
     """Reference tip history (Lobatto IIIA-3, h_ref, Newton tol 1e-10) and its estimated error."""
     fine = run_ours(n, "lobatto3", h_ref, t_end, 1e-10)
     coarse = run_ours(n, "lobatto3", 2 * h_ref, t_end, 1e-10)
-    est = _error(coarse, fine["t"], fine["tip"]) / 15.0   # order 4: e(h) ~ e(2h) / 16
+    est = equal.tip_error(coarse, fine["t"], fine["tip"]) / 15.0   # order 4: e(h) ~ e(2h) / 16
     return fine["t"], fine["tip"], est
 
 
@@ -117,90 +111,16 @@ def case(n, t_end, repeats, tol, h_ref, methods):
     configs = [("ours", m, x) for m in methods for x in OURS[m][1]]
     if peer is not None and peer.available():
         configs += [("exudyn", m, h) for m, hs in PEER.items() for h in hs]
-    runs = {c: [] for c in configs}
-    failed = set()
-    for _ in range(repeats):
-        for c in configs:
-            if c in failed:
-                continue
-            side, m, x = c
-            try:
-                r = run_ours(n, m, x, t_end, tol) if side == "ours" else run_peer(n, m, x, t_end, tol)
-            except RuntimeError as exc:
-                r = dict(ok=False, message=str(exc))
-            if not r["ok"]:
-                failed.add(c)
-                print(f"  {side} {m} {x:g}: failed ({r['message']})", flush=True)
-                continue
-            runs[c].append(r)
-    rows = []
-    print(f"{'side':<7}{'method':<19}{'h or rtol':>10}{'CPU s':>9}{'error m':>10}{'it/step':>8}{'LU':>7}")
-    for c in configs:
-        if c in failed or not runs[c]:
-            continue
-        rs = runs[c]
-        cpu = float(np.median([r["cpu"] for r in rs]))
-        err = _error(rs[-1], t_ref, tip_ref)
-        rows.append((c, cpu, err))
-        print(f"{c[0]:<7}{c[1]:<19}{c[2]:>10.1e}{cpu:9.3f}{err:10.2e}{rs[-1]['it_per_step']:8.2f}{rs[-1]['lu']:7d}",
-              flush=True)
-    summary(rows)
-    per_method(rows)
+
+    def run(side, method, x):
+        return run_ours(n, method, x, t_end, tol) if side == "ours" else run_peer(n, method, x, t_end, tol)
+
+    runs = equal.interleaved(configs, run, repeats)
+    rows = equal.table(runs, lambda c, r: equal.tip_error(r, t_ref, tip_ref), x_name="h or rtol",
+                       columns=[("it/step", 8, ".2f", "it_per_step"), ("LU", 7, "d", "lu")])
+    equal.summary(rows)
+    equal.per_method(rows)
     return rows
-
-
-def summary(rows):
-    """At each Exudyn accuracy level: the cheapest run of each side at least as accurate."""
-    ex = [r for r in rows if r[0][0] == "exudyn"]
-    us = [r for r in rows if r[0][0] == "ours"]
-    if not ex:
-        return
-    print("at equal accuracy (each Exudyn error level; cheapest run of each side with error <= it):")
-    for level in sorted({r[2] for r in ex}, reverse=True):
-        e_best = min((r for r in ex if r[2] <= level), key=lambda r: r[1])
-        o = [r for r in us if r[2] <= level]
-        if not o:
-            print(f"  {level:9.2e} m: Exudyn {e_best[0][1]} h={e_best[0][2]:g} {e_best[1]:.3f} s | "
-                  f"no run of ours this accurate")
-            continue
-        o_best = min(o, key=lambda r: r[1])
-        interp = _interpolated_cost(us, level)
-        print(f"  {level:9.2e} m: Exudyn {e_best[0][1]} h={e_best[0][2]:g} {e_best[1]:.3f} s | ours "
-              f"{o_best[0][1]} {o_best[0][2]:g} {o_best[1]:.3f} s (error {o_best[2]:.1e}) | ratio "
-              f"{o_best[1] / e_best[1]:.2f}" + (f" (log-log interpolated: {interp / e_best[1]:.2f})"
-                                                  if interp is not None else ""), flush=True)
-
-
-def per_method(rows):
-    """For each run of ours: the cheapest Exudyn run (either integrator) at least as accurate, and the ratio."""
-    ex = [r for r in rows if r[0][0] == "exudyn"]
-    if not ex:
-        return
-    print("per method of ours (each run against Exudyn's cheapest run with error <= it):")
-    for (side, m, x), cpu, err in rows:
-        if side != "ours":
-            continue
-        e = [r for r in ex if r[2] <= err]
-        if not e:
-            print(f"  {m:<19}{x:9.1e} {cpu:.3f} s error {err:.1e} | no Exudyn run this accurate")
-            continue
-        b = min(e, key=lambda r: r[1])
-        print(f"  {m:<19}{x:9.1e} {cpu:.3f} s error {err:.1e} | Exudyn {b[0][1]} h={b[0][2]:g} {b[1]:.3f} s "
-              f"(error {b[2]:.1e}) | ratio {cpu / b[1]:.2f}", flush=True)
-
-
-def _interpolated_cost(runs, level):
-    """Cheapest cost of ours at error ``level``, interpolating each method's log(cost) over log(error)
-    between its sampled runs (None if no method's runs bracket the level)."""
-    best = None
-    for method in {r[0][1] for r in runs}:
-        pts = sorted((r[2], r[1]) for r in runs if r[0][1] == method)
-        for (e0, c0), (e1, c1) in zip(pts, pts[1:]):
-            if e0 <= level <= e1 and e1 > e0:
-                w = np.log(level / e0) / np.log(e1 / e0)
-                c = float(np.exp((1 - w) * np.log(c0) + w * np.log(c1)))
-                best = c if best is None else min(best, c)
-    return best
 
 
 def main(argv=None):

@@ -38,9 +38,15 @@ def _fmt(value) -> str:
     return f"{value:g}" if isinstance(value, float) else str(value)
 
 
+def _study_name(module) -> str:
+    """``NAME`` of a study module, else the last part of its module name, also when it runs as ``__main__``."""
+    spec = getattr(module, "__spec__", None)      # `python -m ancfdae.studies.X`: __name__ is "__main__"
+    return getattr(module, "NAME", (spec.name if spec is not None else module.__name__).rsplit(".", 1)[-1])
+
+
 def parser(module, prog: str | None = None) -> argparse.ArgumentParser:
     """The argument parser of a study module (its options, with the full and the quick defaults)."""
-    name = getattr(module, "NAME", module.__name__.rsplit(".", 1)[-1])
+    name = _study_name(module)
     doc = (module.__doc__ or name).strip().splitlines()[0]
     p = argparse.ArgumentParser(prog=prog or f"ancfdae study {name}", description=doc)
     p.add_argument("--quick", action="store_true", help="small, fast version (what the tests run)")

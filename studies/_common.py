@@ -1,4 +1,4 @@
-"""Shared plumbing of the studies: output folder, the case runner that keeps every finished case, tables.
+"""Shared plumbing of the studies: options, output folder, and the case runner that keeps every finished case.
 
 A study is a sweep of independent cases (one simulation each). :func:`run_cases`
 runs them serially or through an executor, writes each finished case to the
@@ -7,6 +7,32 @@ previous run with the same options left there, records a case that raises as
 that case's failure and goes on, and on Ctrl-C cancels the rest, stops its own
 worker processes and raises :class:`Interrupted` (the command line prints one
 line and exits 130).
+
+Every study's ``run``
+---------------------
+Besides its own options, every study's ``run`` takes the sweep options
+
+``quick``
+    the test-suite mode: the study's ``QUICK`` defaults over its ``FULL`` ones;
+``out``
+    the output folder (default ``out/NAME``, ``out/NAME-quick`` with ``quick``),
+    checked before any work; each case is stored there when it finishes and a
+    rerun reuses the stored cases;
+``jobs``, ``executor``
+    worker processes, or any ``concurrent.futures.Executor`` (e.g. a Dask
+    ``Client().get_executor()``, which overrides ``jobs``), see :func:`run_cases`;
+``plots``
+    write the markdown table and the figures (PNG and SVG); with
+    ``plots=False`` and no ``out`` nothing is written;
+``progress``
+    a progress bar on stderr;
+
+and returns a dict with the study's own results (``rows``, ...) and the keys
+``errors`` (``{case label: error text}`` of the cases that raised),
+``reused`` (cases taken from ``out``), ``figures`` (``{file stem: Figure}``),
+``table`` (markdown, :mod:`ancfdae.studies._tables`) and ``path`` (the output
+folder or None). The command line (:mod:`ancfdae.studies._cli`) maps
+``ancfdae study NAME`` onto ``run``.
 """
 from __future__ import annotations
 
@@ -24,8 +50,8 @@ from pathlib import Path
 
 from ancfdae.result import Result
 
-__all__ = ["Case", "OptionError", "output_dir", "CaseStore", "Sweep", "Interrupted", "run_cases", "markdown_table",
-           "progress_bar", "settings"]
+__all__ = ["Case", "OptionError", "output_dir", "CaseStore", "Sweep", "Interrupted", "run_cases", "progress_bar",
+           "settings"]
 
 
 class OptionError(ValueError):
@@ -338,17 +364,6 @@ def _stop(pool) -> None:
     deadline = time.monotonic() + 5.0
     for p in procs:
         p.join(timeout=max(0.0, deadline - time.monotonic()))
-
-
-def markdown_table(headers, rows) -> str:
-    """A GitHub markdown table; floats printed with 4 significant digits."""
-    def fmt(x):
-        if isinstance(x, float):
-            return f"{x:.4g}" if 1e-3 <= abs(x) < 1e4 or x == 0 else f"{x:.3e}"
-        return str(x)
-    lines = ["| " + " | ".join(headers) + " |", "|" + "---|" * len(headers)]
-    lines += ["| " + " | ".join(fmt(x) for x in row) + " |" for row in rows]
-    return "\n".join(lines) + "\n"
 
 
 def settings(full: dict, quick_defaults: dict, quick: bool, given: dict) -> dict:

@@ -12,6 +12,7 @@ Run: ``ancfdae study cantilever [--quick] [--out DIR] [--elements ...] [--n-elem
 """
 from __future__ import annotations
 
+import sys
 import time
 
 import numpy as np
@@ -21,8 +22,9 @@ from ancfdae import models
 
 from ancfdae.result import Result
 
-from ._cli import Option
-from ._common import Case, OptionError, markdown_table, output_dir, run_cases, settings
+from ._cli import Option, main as cli_main
+from ._common import Case, OptionError, output_dir, run_cases, settings
+from ._tables import errors_note, markdown_table
 
 __all__ = ["run", "run_case", "build", "solve_case", "ELEMENTS", "TABLE2", "REFERENCE", "FULL", "QUICK",
            "CLI_OPTIONS"]
@@ -187,24 +189,16 @@ def run(elements=None, n_elements=None, repeats=None, quick: bool = False, out=N
         Meshes (chapter: 1 ... 64; quick: 1 ... 16).
     repeats : int
         Solves per case for the median CPU time (quick: 1).
-    quick : bool
-        Small meshes and one repeat: the test-suite mode.
-    out : path, optional
-        Output folder (default ``out/cantilever``, ``out/cantilever-quick``
-        with ``quick``); checked before any work; each solved case is stored
-        there and reused by a rerun. ``None`` with ``plots=False`` writes
-        nothing.
-    plots : bool
-        Write the markdown table and the figures (PNG and SVG).
-    progress : bool
-        Progress bar on stderr.
+    quick, out, plots, progress
+        The sweep options of every study (:mod:`ancfdae.studies._common`);
+        ``quick``: small meshes and one repeat. The cases run serially (no
+        ``jobs``): their CPU times are the study's result.
 
     Returns
     -------
     dict
         ``rows`` (one dict per element type and mesh), ``orders`` (regressed
-        convergence order per type), ``errors``, ``reused``, ``figures``,
-        ``table`` (markdown) and ``path``.
+        convergence order per type), with the keys of every study.
     """
     o = settings(FULL, QUICK, quick, dict(elements=elements, n_elements=n_elements, repeats=repeats))
     names = list(o["elements"]) if o["elements"] else available_elements()
@@ -235,9 +229,7 @@ def run(elements=None, n_elements=None, repeats=None, quick: bool = False, out=N
     table = markdown_table(headers, table_rows)
     table += "\nConvergence order (log-log fit, 4 elements and up): " + ", ".join(
         f"{k} {v:.2f}" for k, v in orders.items()) + "\n"
-    if sweep.errors:
-        table += "\nCases that raised (not in the table): " + "; ".join(
-            f"{k}: {v}" for k, v in sweep.errors.items()) + "\n"
+    table += errors_note(sweep.errors)
     figures = {}
     if plots:
         (path / "table2.md").write_text("# B1 largely deforming cantilever (chapter Table 2)\n\n" + table)
@@ -246,12 +238,5 @@ def run(elements=None, n_elements=None, repeats=None, quick: bool = False, out=N
             "table": table, "path": path}
 
 
-def main(argv=None) -> int:
-    """Command-line entry: ``python -m ancfdae.studies.cantilever --help``."""
-    import sys
-    from ._cli import main as cli_main
-    return cli_main(sys.modules[__name__], argv)
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())
+if __name__ == "__main__":     # python -m ancfdae.studies.cantilever: the same as `ancfdae study cantilever`
+    raise SystemExit(cli_main(sys.modules[__name__]))

@@ -17,13 +17,15 @@ Run: ``ancfdae study energy [--quick] [--out DIR] [--jobs N]``.
 from __future__ import annotations
 
 import os
+import sys
 
 import numpy as np
 
 from ancfdae.simulate import METHODS
 
-from ._cli import Option
-from ._common import Case, OptionError, markdown_table, output_dir, run_cases, settings
+from ._cli import Option, main as cli_main
+from ._common import Case, OptionError, output_dir, run_cases, settings
+from ._tables import cell, errors_note, markdown_table
 from ._flying import T_HAT, T_PULSE, available, b2_beam, b3_beam, simulate_case, steady_drift, unpack
 
 __all__ = ["run", "run_case", "INTEGRATORS", "FULL", "QUICK", "CLI_OPTIONS"]
@@ -107,16 +109,15 @@ def run(elements=None, integrators=None, n: int | None = None, t_end_b2=None, t_
         End times of the planar and the spatial runs.
     h, dt_out : float
         Step of the fixed-step methods and output interval.
-    quick : bool
-        Test-suite mode: BE2D, 2 elements, 4 s, h = 4e-3.
-    out, jobs, executor, plots, progress
-        As in :func:`studies.flying2d.run`.
+    quick, out, jobs, executor, plots, progress
+        The sweep options of every study (:mod:`ancfdae.studies._common`);
+        ``quick``: BE2D, 2 elements, 4 s, h = 4e-3.
 
     Returns
     -------
     dict
-        ``rows`` (summary per run), ``records`` (histories), ``errors``,
-        ``reused``, ``figures``, ``table``, ``path``.
+        ``rows`` (summary per run) and ``records`` (histories), with the
+        keys of every study.
     """
     o = settings(FULL, QUICK, quick, dict(elements=elements, integrators=integrators, n=n, t_end_b2=t_end_b2,
                                           t_end_b3=t_end_b3, h=h, dt_out=dt_out))
@@ -155,25 +156,19 @@ def run(elements=None, integrators=None, n: int | None = None, t_end_b2=None, t_
             "table": table, "path": path}
 
 
-def _f(x, spec):
-    return "-" if x is None or (isinstance(x, float) and not np.isfinite(x)) else format(x, spec)
-
-
 def _table(rows, h, errors):
     headers = ["element", "problem", "integrator", "run to (s)", "reached (s)", "fails at (s)", "blow-up at (s)",
                "T+U at load end (J)", "max drift after load (J)", "relative", "rate (J/s)", "CPU (s)"]
     body = [[r["element"] + f" {r['n']} el", r["problem"], r["integrator"], f"{r['t_end']:g}",
-             f"{r['t_reached']:.2f}", _f(r["t_fail"], ".2f") if r["failed"] else "-", _f(r["t_blow_up"], ".2f"),
-             _f(r["energy"], ".4g"), _f(r["drift"], ".2e"), _f(r["relative"], ".1e"), _f(r["rate"], ".1e"),
+             f"{r['t_reached']:.2f}", cell(r["t_fail"], ".2f") if r["failed"] else "-", cell(r["t_blow_up"], ".2f"),
+             cell(r["energy"], ".4g"), cell(r["drift"], ".2e"), cell(r["relative"], ".1e"), cell(r["rate"], ".1e"),
              f"{r['cpu']:.1f}"] for r in rows]
     ida = sorted({r["max_order"] for r in rows if r["integrator"] == "ida" and r["max_order"] is not None})
     text = (f"Fixed-step methods: h = {h:g} s, modified Newton tol 1e-8; IDA: rtol 1e-6"
             + (f", max order {', '.join(map(str, ida))}" if ida else "") + ", at most 400 000 steps. "
             "Planar elements: B2 (load ends at 2.5 s); spatial: B3 (load ends at 3 s).\n\n")
     text += markdown_table(headers, body)
-    if errors:
-        text += "\nCases that raised (not in the table): " + "; ".join(f"{k}: {v}" for k, v in errors.items()) + "\n"
-    return text
+    return text + errors_note(errors)
 
 
 def _plot(records, path) -> dict:
@@ -199,3 +194,7 @@ def _plot(records, path) -> dict:
         ax.set_visible(False)
     save(fig, path, "energy_drift")
     return {"energy_drift": fig}
+
+
+if __name__ == "__main__":     # python -m ancfdae.studies.energy: the same as `ancfdae study energy`
+    raise SystemExit(cli_main(sys.modules[__name__]))

@@ -21,10 +21,13 @@ Run: ``ancfdae study flying2d [--quick] [--out DIR] [--jobs N] [--elements ...] 
 """
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
-from ._cli import Option
-from ._common import OptionError, markdown_table, output_dir, run_cases, settings
+from ._cli import Option, main as cli_main
+from ._common import OptionError, output_dir, run_cases, settings
+from ._tables import errors_note, markdown_table
 from ._flying import FAMILY, Case, T_PULSE, available, b2_beam, eps_T, regress_order, simulate_case, steady_drift, \
     unpack
 
@@ -83,29 +86,17 @@ def run(elements=None, n_elements=None, n_ref=None, n_elements_3d=None, t_end=No
         the planar ones; they are compared with the planar reference).
     t_end, h, dt_out : float
         Time span (chapter: 10 s), step (1e-3 s) and output interval.
-    quick : bool
-        Test-suite mode: BE2D, 4, 8, 16 elements against 32, over the whole
+    quick, out, jobs, executor, plots, progress
+        The sweep options of every study (:mod:`ancfdae.studies._common`);
+        ``quick``: BE2D, 4, 8, 16 elements against 32, over the whole
         [0, 10] s at h = 1e-3.
-    out : path, optional
-        Output folder (default ``out/flying2d``, ``out/flying2d-quick`` with
-        ``quick``); checked before any work. Each case is stored there when
-        it finishes, and a rerun reuses the stored cases.
-    jobs : int, optional
-        Worker processes (``ancfdae study flying2d --jobs 2``).
-    executor : concurrent.futures.Executor, optional
-        E.g. a Dask ``Client().get_executor()``; overrides ``jobs``.
-    plots : bool
-        Write ``flying2d.md`` and the figures (PNG and SVG). With
-        ``plots=False`` and no ``out`` nothing is written.
-    progress : bool
-        Progress bar on stderr.
 
     Returns
     -------
     dict
         ``rows`` (per run), ``orders`` (regressed order of eps_T against the
-        number of elements, per type), ``references``, ``errors`` (cases that
-        raised), ``reused``, ``figures``, ``table``, ``path``.
+        number of elements, per type) and ``references``, with the keys of
+        every study.
     """
     o = settings(FULL, QUICK, quick, dict(elements=elements, n_elements=n_elements, n_ref=n_ref,
                                           n_elements_3d=n_elements_3d, t_end=t_end, h=h, dt_out=dt_out))
@@ -202,17 +193,8 @@ def _table(rows, references, orders, n_ref, t_end, h, errors):
         text += "\n3D types in the plane against their planar twin with the same mesh (max tip difference, " \
                 "max |z|): " + ", ".join(f"{r['element']} {r['n']} el {r['twin_difference']:.1e} m, "
                                           f"{r['max_abs_z']:.1e} m" for r in checks) + "\n"
-    if errors:
-        text += "\nCases that raised (not in the table): " + "; ".join(f"{k}: {v}" for k, v in errors.items()) + "\n"
-    return text
+    return text + errors_note(errors)
 
 
-def main(argv=None) -> int:
-    """Command-line entry: ``python -m ancfdae.studies.flying2d --help``."""
-    from ._cli import main as cli_main
-    import sys
-    return cli_main(sys.modules[__name__], argv)
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())
+if __name__ == "__main__":     # python -m ancfdae.studies.flying2d: the same as `ancfdae study flying2d`
+    raise SystemExit(cli_main(sys.modules[__name__]))

@@ -35,12 +35,15 @@ Run: ``ancfdae study flying3d [--quick] [--out DIR] [--jobs N] [--be-meshes ...]
 """
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
 from ancfdae.simulate import METHODS
 
-from ._cli import Option
-from ._common import Case, OptionError, markdown_table, output_dir, run_cases, settings
+from ._cli import Option, main as cli_main
+from ._common import Case, OptionError, output_dir, run_cases, settings
+from ._tables import cell, errors_note, markdown_table
 from ._flying import T_HAT, available, b3_beam, simulate_case, steady_drift, unpack
 
 __all__ = ["run", "run_case", "summarize", "UpdateAudit", "FULL", "QUICK", "CLI_OPTIONS", "CHAPTER_FAILURES"]
@@ -235,17 +238,16 @@ def run(be_meshes=None, sq_meshes=None, variants=None, variant_mesh=None, method
         End times of the BE3D and the SQ3D runs.
     h, dt_out : float
         Step and output interval.
-    quick : bool
-        Test-suite mode: the moment hat shortened to 1 s; BE3D 2 el (h = 2e-3)
+    quick, out, jobs, executor, plots, progress
+        The sweep options of every study (:mod:`ancfdae.studies._common`);
+        ``quick``: the moment hat shortened to 1 s; BE3D 2 el (h = 2e-3)
         and SQ3D 2 el (h = 4e-3 and 2e-3; energy-momentum h = 4e-3) to 1.5 s.
-    out, jobs, executor, plots, progress
-        As in :func:`studies.flying2d.run`.
 
     Returns
     -------
     dict
-        ``rows`` (summary per run), ``records`` (histories), ``errors``,
-        ``reused``, ``figures``, ``table``, ``path``.
+        ``rows`` (summary per run) and ``records`` (histories), with the
+        keys of every study.
     """
     o = settings(FULL, QUICK, quick, dict(be_meshes=be_meshes, sq_meshes=sq_meshes, variants=variants,
                                           variant_mesh=variant_mesh, methods=methods, long_run=long_run, t_end=t_end,
@@ -275,10 +277,6 @@ def run(be_meshes=None, sq_meshes=None, variants=None, variant_mesh=None, method
             "table": table, "path": path}
 
 
-def _fmt(x, spec=".3g"):
-    return "-" if x is None or (isinstance(x, float) and not np.isfinite(x)) else format(x, spec)
-
-
 def _table(rows, missing, errors):
     headers = ["element", "#NEL", "director update", "integrator", "h (s)", "run to (s)", "fails at (s)",
                "chapter: fails at (s)", "blow-up flagged (s)", "balance off by 1 % at (s)", "T+U at load end (J)",
@@ -291,27 +289,18 @@ def _table(rows, missing, errors):
             jumps = f"{r['update_net_load']:.2e} / {r['update_net_free']:.2e}"
             per = f"{r['update_mean']:.1e} / {r['update_max']:.1e}"
         body.append([r["element"], r["n"], r["director_update"], r["method"], f"{r['h']:g}", f"{r['t_end']:g}",
-                     _fmt(r["t_fail"], ".3f") if r["status"] != "success" else "-",
-                     _fmt(r["chapter_fails"], "g"), _fmt(r["t_blow_up"], ".2f"), _fmt(r["t_drift_1pc"], ".2f"),
-                     _fmt(r["energy_at_load_end"], ".4g"), _fmt(r["balance_at_load_end"], ".2e"),
-                     _fmt(r["drift_max"], ".2e"), _fmt(r["drift_rate"], ".2e"), jumps, per, f"{r['cpu']:.0f}"])
+                     cell(r["t_fail"], ".3f") if r["status"] != "success" else "-",
+                     cell(r["chapter_fails"], "g"), cell(r["t_blow_up"], ".2f"), cell(r["t_drift_1pc"], ".2f"),
+                     cell(r["energy_at_load_end"], ".4g"), cell(r["balance_at_load_end"], ".2e"),
+                     cell(r["drift_max"], ".2e"), cell(r["drift_rate"], ".2e"), jumps, per, f"{r['cpu']:.0f}"])
     t_load = rows[0]["t_load"] if rows else T_HAT
     text = (f"Modified Newton tol 1e-8 (energy-momentum: its own, round-off); the moment ends at {t_load:g} s. "
             "Chapter: Lobatto IIIA, h = 1e-3 s.\n\n")
     text += markdown_table(headers, body)
     if missing:
         text += f"\nNot available in ancfdae.models: {', '.join(missing)}.\n"
-    if errors:
-        text += "\nCases that raised (not in the table): " + "; ".join(f"{k}: {v}" for k, v in errors.items()) + "\n"
-    return text
+    return text + errors_note(errors)
 
 
-def main(argv=None) -> int:
-    """Command-line entry: ``python -m ancfdae.studies.flying3d --help``."""
-    import sys
-    from ._cli import main as cli_main
-    return cli_main(sys.modules[__name__], argv)
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())
+if __name__ == "__main__":     # python -m ancfdae.studies.flying3d: the same as `ancfdae study flying3d`
+    raise SystemExit(cli_main(sys.modules[__name__]))

@@ -26,13 +26,15 @@ Run: ``ancfdae study integrators [--quick] [--out DIR] [--jobs N]``.
 from __future__ import annotations
 
 import os
+import sys
 
 import numpy as np
 
 from ancfdae.simulate import METHODS as _AVAILABLE
 
-from ._cli import Option
-from ._common import Case, OptionError, markdown_table, output_dir, run_cases, settings
+from ._cli import Option, main as cli_main
+from ._common import Case, OptionError, output_dir, run_cases, settings
+from ._tables import errors_note, markdown_table
 from ._flying import T_PULSE, b2_beam, eps_T, regress_order, simulate_case, steady_drift, unpack
 
 __all__ = ["run", "run_case", "METHODS", "FULL", "QUICK", "CLI_OPTIONS"]
@@ -135,18 +137,17 @@ def run(models=None, element=None, n=None, t_end=None, dt_out=None, steps=None, 
         Keys of :data:`METHODS`.
     h_ref : float
         Step of the reference run.
-    quick : bool
-        Test-suite mode: B2 only, 2 elements, 1 s, three steps, two IDA
+    quick, out, jobs, executor, plots, progress
+        The sweep options of every study (:mod:`ancfdae.studies._common`);
+        ``quick``: B2 only, 2 elements, 1 s, three steps, two IDA
         tolerances, no Newton-tolerance sweep.
-    out, jobs, executor, plots, progress
-        As in :func:`studies.flying2d.run`.
 
     Returns
     -------
     dict
         ``rows`` (one per run), ``orders`` (``{model: {method: order}}``, all
-        steps), ``orders_fine`` (the three finest steps), ``errors``,
-        ``reused``, ``figures``, ``table``, ``path``.
+        steps) and ``orders_fine`` (the three finest steps), with the keys of
+        every study.
     """
     o = settings(FULL, QUICK, quick, dict(models=models, element=element, n=n, t_end=t_end, dt_out=dt_out,
                                           steps=steps, rtols=rtols, newton_tols=newton_tols, methods=methods,
@@ -227,9 +228,7 @@ def _table(rows, orders, orders_fine, refs, t_end, errors):
         f"{model}: " + ", ".join(f"{m} {p:.2f}" for m, p in o.items()) for model, o in orders.items()) + "\n"
     text += "\nObserved order in h (three finest steps): " + "; ".join(
         f"{model}: " + ", ".join(f"{m} {p:.2f}" for m, p in o.items()) for model, o in orders_fine.items()) + "\n"
-    if errors:
-        text += "\nCases that raised (not in the table): " + "; ".join(f"{k}: {v}" for k, v in errors.items()) + "\n"
-    return text
+    return text + errors_note(errors)
 
 
 def _plot(rows, orders, path) -> dict:
@@ -264,3 +263,7 @@ def _plot(rows, orders, path) -> dict:
             ax.legend(fontsize=7)
     save(fig, path, "work_precision")
     return {"work_precision": fig}
+
+
+if __name__ == "__main__":     # python -m ancfdae.studies.integrators: the same as `ancfdae study integrators`
+    raise SystemExit(cli_main(sys.modules[__name__]))

@@ -11,7 +11,8 @@ import numpy as np
 
 from ancfdae.result import Result
 from ancfdae.studies._cli import Option
-from ancfdae.studies._common import Case, markdown_table, output_dir, run_cases, settings
+from ancfdae.studies._common import Case, output_dir, run_cases, settings
+from ancfdae.studies._tables import markdown_table
 
 NAME = "toy"
 FULL = dict(n_cases=4, sleep=0.01, fail=-1)

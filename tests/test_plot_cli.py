@@ -93,8 +93,20 @@ def test_cli_version_export_animate(run2d, tmp_path, capsys):
         main(["export", "vtk", str(bad), str(tmp_path / "v2")])
 
 
-def test_python_dash_m():
-    out = subprocess.run([sys.executable, "-m", "ancfdae", "--version"], capture_output=True, text=True, check=True)
+def test_studies_missing_from_an_uninstalled_checkout_is_a_clear_exit(monkeypatch):
+    """Catches a bare ModuleNotFoundError traceback where a checkout's ancfdae, not installed (on the path
+    before the installed one), lacks the studies, which only installation maps to ancfdae.studies."""
+    monkeypatch.setitem(sys.modules, "ancfdae.studies", None)     # what such an import finds: nothing
+    with pytest.raises(SystemExit, match="studies are not importable.*not installed.*pip install -e"):
+        main(["studies"])
+    with pytest.raises(SystemExit, match="studies are not importable"):
+        main(["study", "cantilever", "--quick"])
+
+
+def test_python_dash_m(tmp_path):
+    # run outside the checkout, as a user would: -m puts the current folder first on sys.path
+    out = subprocess.run([sys.executable, "-m", "ancfdae", "--version"], capture_output=True, text=True, check=True,
+                         cwd=tmp_path)
     assert out.stdout.strip() == f"ancfdae {ancfdae.__version__}"
 
 

@@ -1,11 +1,15 @@
 """Result: time-major arrays, status, and the NetCDF4 file round trip."""
+import dataclasses
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
 import xarray as xr
 
 from ancfdae import EnergyMonitor, Gravity, Material, PointSensor, RectangularSection, Result, ResultFileError, simulate
+from ancfdae import _resultfile
+from ancfdae.export import beam_of
 from ancfdae.models import BE2D, BE3D, SQ2D, SQ3D, Beam, Cable3D
 from toy_models import SpringChain
 
@@ -183,3 +187,38 @@ def test_damaged_content_is_a_clear_error(saved, tmp_path):
     ds.to_netcdf(tmp_path / "badattr.nc", engine="netcdf4")
     with pytest.raises(ResultFileError, match="badattr.nc.*'stats' is not JSON"):
         Result.load(tmp_path / "badattr.nc")
+    ds.attrs["stats"] = "{}"
+    ds.attrs["status"] = "converged"          # read fine, but Result refuses it: still a file error
+    ds.to_netcdf(tmp_path / "badstatus.nc", engine="netcdf4")
+    with pytest.raises(ResultFileError, match="badstatus.nc: damaged ancfdae result file: `status` must be one of"):
+        Result.load(tmp_path / "badstatus.nc")
+
+
+#: A result file written by the code before the result-file module stopped building Results itself
+#: (format ancfdae.Result/2): BE3D, 2 elements clamped at node 0, gravity and a tip moment (0, 0, 0.5),
+#: E = 1e6, nu = 0.3, rho = 1000, square 0.1; lobatto3, h = 0.005 over [0, 0.02]; monitors
+#: EnergyMonitor(), PointSensor(s=1.0) and Probe("tip_q", the last three coordinates).
+OLD_FILE = Path(__file__).parent / "data" / "result_format2_be3d.nc"
+
+
+def test_a_file_written_by_earlier_code_loads_and_is_written_again_identically(tmp_path):
+    """Catches a change of the on-disk layout (a variable, dimension or attribute renamed or dropped, a
+    dtype or a JSON text changed) that would leave users' earlier files unreadable or new files different."""
+    old = Result.load(OLD_FILE)
+    assert old.success and old.method == "lobatto3" and old.t.size == 5 and old.q.shape == (5, 15)
+    assert set(old.monitors) == {"energy", "point@1", "tip_q"} and old.monitors["energy"]["blow_up"] is False
+    assert old.model_state["directors"].shape == (5, 3, 3)
+    again = old.save(tmp_path / "again.nc")
+    with xr.open_dataset(OLD_FILE) as before, xr.open_dataset(again) as after:
+        xr.testing.assert_identical(before, after)        # values bit for bit, names, dims, attributes
+        for name in before.variables:
+            assert before[name].dtype == after[name].dtype, name
+        np.testing.assert_array_equal(old.q, before["q"].values)
+    _assert_same(Result.load(again), old)
+    beam = beam_of(old)                                    # the description still rebuilds the beam
+    assert beam.element.name == "BE3D" and beam.n_dof == old.q.shape[1]
+
+
+def test_the_result_file_module_writes_every_field_of_result():
+    """Catches a field added to Result but not to the file layout (it would be lost by save/load)."""
+    assert _resultfile.FIELDS == tuple(f.name for f in dataclasses.fields(Result))

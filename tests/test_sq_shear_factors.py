@@ -10,11 +10,12 @@ bending axis (exact in the structural formulation; independent of the shear fact
 the example runs with k2 != k3 through the public API and that I2/I3 are not swapped).
 """
 import importlib.util
+from dataclasses import dataclass
 
 import numpy as np
 import pytest
 
-from ancfdae import CircularSection, Material, PointForce, PointMoment, RectangularSection, solve_static
+from ancfdae import CircularSection, Material, PointForce, PointMoment, RectangularSection, Section, solve_static
 from ancfdae.models import SQ2D, SQ3D, Beam
 
 K1, K2, K3 = 0.5768, 0.8331, 0.7961
@@ -147,3 +148,51 @@ def test_shear_factor_input_is_checked(mat):
     assert SECTION.shear_factors_of(mat) == (K2, K3)
     assert RectangularSection(0.1, shear_factors=(0.7, 0.7)).k_s(mat) == 0.7
     assert RectangularSection(0.1).shear_factors_of(mat) == (RectangularSection(0.1).k_s(mat),) * 2
+
+
+@dataclass(frozen=True)
+class _Tube(Section):
+    """A thin-walled tube of mean diameter d and wall t: a user's own shape on the Section base."""
+
+    d: float
+    t: float
+    shear_factor: float | None = None
+    torsion_factor: float | None = None
+    shear_factors: tuple | None = None
+
+    def _check_dimensions(self):
+        object.__setattr__(self, "d", float(self.d))
+
+    A = property(lambda self: np.pi * self.d * self.t)
+    I2 = I3 = property(lambda self: np.pi * self.d**3 * self.t / 8)
+    I4 = property(lambda self: 3 * np.pi * self.d**5 * self.t / 128)
+
+    def _default_shear_factor(self, nu):
+        return 0.5
+
+    def _default_torsion_factor(self):
+        return 1.0
+
+
+def test_a_new_shape_gets_the_factor_rules_of_every_section(mat):
+    """Catches a shape that skips the shared checks or defaults (each shape would re-implement them), and
+    a shape that forgets a moment (it cannot be made, instead of failing inside an element)."""
+    tube = _Tube(0.1, 0.002)
+    assert tube.J == 2 * tube.I2 and tube.k_t == 1.0 and tube.shear_factors_of(mat) == (0.5, 0.5)
+    assert _Tube(0.1, 0.002, shear_factors=(0.6, 0.4), torsion_factor=0.9).shear_factors_of(mat) == (0.6, 0.4)
+    with pytest.raises(ValueError, match="not both"):
+        _Tube(0.1, 0.002, shear_factor=0.5, shear_factors=(0.6, 0.4))
+    with pytest.raises(ValueError, match="`torsion_factor` must be a positive"):
+        _Tube(0.1, 0.002, torsion_factor=0.0)
+
+    @dataclass(frozen=True)
+    class NoI4(Section):
+        shear_factor: float | None = None
+        torsion_factor: float | None = None
+        shear_factors: tuple | None = None
+        A = I2 = I3 = property(lambda self: 1.0)
+        _check_dimensions = _default_torsion_factor = lambda self: None
+        _default_shear_factor = lambda self, nu: 1.0
+
+    with pytest.raises(TypeError, match="I4"):
+        NoI4()

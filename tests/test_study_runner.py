@@ -1,6 +1,7 @@
 """The studies' runner keeps every finished case: stored as it finishes, reused, failures isolated, Ctrl-C safe."""
 import json
 import os
+import runpy
 import signal
 import subprocess
 import sys
@@ -16,7 +17,6 @@ from ancfdae.studies import _cli
 from ancfdae.studies._common import Case, output_dir, run_cases
 
 HERE = Path(__file__).parent
-ROOT = HERE.parent
 _MAIN = "import sys, study_toy; from ancfdae.studies import _cli; sys.exit(_cli.main(study_toy, sys.argv[1:]))"
 # A terminal's Ctrl-C: the child gets Python's SIGINT handler even when the test session itself runs in the
 # background (where the shell made SIGINT ignored, and children inherit that)
@@ -81,15 +81,30 @@ def test_cli_help_states_the_defaults(capsys):
     assert "number of cases (default: 4; with --quick: 2)" in text and "out/toy-quick" in text
 
 
+# runpy warns that the session has imported the study already: harmless, -m starts from a fresh interpreter
+@pytest.mark.filterwarnings("ignore:.*found in sys.modules after import of package:RuntimeWarning")
+@pytest.mark.parametrize("name", ["cantilever", "energy", "flying2d", "flying3d", "integrators"])
+def test_python_dash_m_runs_each_study_under_its_own_name(name, monkeypatch, capsys):
+    """Catches a study without the `python -m ancfdae.studies.NAME` entry (energy and integrators had none)
+    and a command line that calls the study "__main__" (the __name__ of a module run by -m)."""
+    monkeypatch.setattr(sys, "argv", [name, "--help"])
+    with pytest.raises(SystemExit) as exc:
+        runpy.run_module(f"ancfdae.studies.{name}", run_name="__main__", alter_sys=True)
+    assert exc.value.code == 0
+    assert capsys.readouterr().out.startswith(f"usage: ancfdae study {name} [-h] [--quick]")
+
+
 def _interrupt(tmp_path, jobs, how="ctrl-c"):
     """Start the toy study in its own session; once 2 cases are stored, Ctrl-C (SIGINT to the process group,
     as a terminal sends it) or ``kill PID`` (SIGTERM to the main process only)."""
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(HERE), str(ROOT)]), TOY_SLOW_FROM="2")
+    env = dict(os.environ, PYTHONPATH=str(HERE), TOY_SLOW_FROM="2")
     args = [sys.executable, "-c", _CTRL_C, "--out", str(tmp_path), "--sleep", "0.1"]
     if jobs:
         args += ["--jobs", str(jobs)]
+    # cwd outside the checkout: `python -c` puts its folder first on sys.path, and a checkout's ancfdae,
+    # not installed, has no ancfdae.studies
     proc = subprocess.Popen(args, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)
+                            start_new_session=True, cwd=tmp_path)
     deadline = time.monotonic() + 120
     while len(list((tmp_path / "cases").glob("*.json"))) < 2:
         assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
@@ -124,7 +139,7 @@ def test_ctrl_c_stops_within_seconds_keeps_finished_cases_and_exits_130(tmp_path
     assert not any(_alive(pid) for pid in workers), "a worker outlived Ctrl-C"
     # the same command again reuses the two finished cases and runs the other two
     again = subprocess.run([sys.executable, "-c", _MAIN, "--out", str(tmp_path), "--sleep", "0.1"],
-                           env=dict(os.environ, PYTHONPATH=os.pathsep.join([str(HERE), str(ROOT)])),
+                           env=dict(os.environ, PYTHONPATH=str(HERE)), cwd=tmp_path,
                            capture_output=True, text=True, timeout=120)
     assert again.returncode == 0 and "reusing 2 of 4 finished cases" in again.stderr, again.stderr
     assert "| case 3 | 9 |" in again.stdout
