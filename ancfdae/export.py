@@ -48,7 +48,7 @@ def beam_of(result: Result) -> Beam:
         If the result carries no beam description (e.g. a model other than
         a Beam).
     """
-    from .models._describe import rebuild
+    from .models.beam.describe import rebuild
     if not result.model or "element" not in result.model:
         raise ValueError("`result` carries no beam description (result.model is empty: the model was not a "
                          "Beam); pass the beam explicitly.")

@@ -4,7 +4,7 @@ import pytest
 
 from ancfdae import Material, PointForce, PointMoment, RectangularSection, solve_static
 from ancfdae.models import BE2D, BE3D, Beam
-from ancfdae.models._be3d_kinematics import spin_coefficients
+from ancfdae.models.thin.be3d_kinematics import spin_coefficients
 from test_be2d import TABLE2_RTOL
 from conftest import fd_gradient, rel_err
 
@@ -344,7 +344,7 @@ def test_cantilever_study_has_the_be3d_and_cable3d_rows():
 
 def test_residual_path_equals_the_jets():
     """The written-out chain rule of the residual path equals the jets' values and gradients."""
-    from ancfdae.models._be3d_kinematics import curvature_energy, curvatures, spin_gradient
+    from ancfdae.models.thin.be3d_kinematics import curvature_energy, curvatures, spin_gradient
     rng = np.random.default_rng(9)
     a, b, d, dp, k_ref = rng.standard_normal((5, 4, 3, 3))
     th, dth = rng.standard_normal((2, 4, 3))

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import finite_vector, positive, positive_int
+from ..._validate import finite_vector, positive, positive_int
 
 __all__ = ["straight_mesh", "mesh_from_points", "frame_from_tangent"]
 

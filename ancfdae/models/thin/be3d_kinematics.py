@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._scalar_jet import Jet
+from ..jets.scalar import Jet
 
 __all__ = ["curvatures", "curvature_energy", "spin_coefficients", "spin_gradient", "frames", "director_field",
            "cross", "EPS"]

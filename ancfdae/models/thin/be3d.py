@@ -11,16 +11,16 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._validate import choice, finite_vector, positive_int
-from ..materials import CircularSection, Material, RectangularSection
-from ._be3d_dynamics import UPDATES, rotary_inertia, rotary_kinetic_energy
-from ._be3d_events import BE3DEvents
-from ._be3d_kinematics import curvature_energy, curvatures, director_field, frames, spin_gradient
-from ._element import Element
-from ._kernel_option import KernelOption
-from ._scalar_jet import Jet
-from ._shapes import hermite, linear
-from ._thin import (PointRule, assemble, axial_energy, check_material_section, clamp_coordinates,
+from ..._validate import choice, finite_vector, positive_int
+from ...materials import CircularSection, Material, RectangularSection
+from .be3d_inertia import UPDATES, rotary_inertia, rotary_kinetic_energy
+from .be3d_directors import BE3DEvents
+from .be3d_kinematics import curvature_energy, curvatures, director_field, frames, spin_gradient
+from ..element import Element
+from .._kernel_option import KernelOption
+from ..jets.scalar import Jet
+from ..shapes import hermite, linear
+from .spatial import (PointRule, assemble, axial_energy, check_material_section, clamp_coordinates,
                     hermite_operator, translational_mass)
 
 __all__ = ["BE3D"]
@@ -260,7 +260,7 @@ class BE3D(KernelOption, BE3DEvents, Element):
 
     def _compiled_forces(self, geom, q, tangent):
         """(U, f, K) from the compiled kernel, with the nodal directors of ``geom``."""
-        from ._be3d_numba import be3d_forces
+        from .be3d_numba import be3d_forces
         ax, bd = geom["axial"], geom["bend"]
         return be3d_forces(np.ascontiguousarray(q, dtype=float), _DOF, _THETA, ax.dN, ax.wdx, geom["slope_ref"],
                            bd.dN, bd.ddN, bd.wdx, bd.lin, geom["L"], self._directors(geom),
@@ -316,7 +316,7 @@ class BE3D(KernelOption, BE3DEvents, Element):
         """
         M = finite_vector("moment", moment, 3)
         if self._impl == "numba":
-            from ._be3d_moment_numba import be3d_moment
+            from .be3d_moment_numba import be3d_moment
             D = self._directors(geom)
             f, K = be3d_moment(np.ascontiguousarray(q, dtype=float), _DOF, _THETA, float(s), float(geom["L"][element]),
                                D[element], D[element + 1], M, bool(tangent))
@@ -358,7 +358,7 @@ class BE3D(KernelOption, BE3DEvents, Element):
         ``jacobian`` is False.
         """
         if self._impl == "numba":
-            from ._be3d_inertia_numba import be3d_inertia
+            from .be3d_inertia_numba import be3d_inertia
             rule = geom["inertia"]
             f, Kq, Dv, Ma = be3d_inertia(*(np.ascontiguousarray(x, dtype=float) for x in (q, v, a)), _DOF, _THETA,
                                          rule.dN, rule.wdx, rule.lin, self._directors(geom), self.rhoJ,
@@ -369,7 +369,7 @@ class BE3D(KernelOption, BE3DEvents, Element):
     def kinetic_energy_extra(self, geom: dict, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``1/2 int rho J omega1^2 dxi`` per element."""
         if self._impl == "numba":
-            from ._be3d_inertia_numba import be3d_kinetic_energy
+            from .be3d_inertia_numba import be3d_kinetic_energy
             rule = geom["inertia"]
             return be3d_kinetic_energy(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(v, dtype=float),
                                        _DOF, _THETA, rule.dN, rule.wdx, rule.lin, self._directors(geom),

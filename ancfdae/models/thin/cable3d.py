@@ -10,12 +10,12 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._validate import finite_vector, positive_int
-from ..materials import CircularSection, Material, RectangularSection
-from ._element import Element
-from ._kernel_option import KernelOption
-from ._shapes import hermite
-from ._thin import (PointRule, assemble, axial_energy, check_material_section, clamp_coordinates,
+from ..._validate import finite_vector, positive_int
+from ...materials import CircularSection, Material, RectangularSection
+from ..element import Element
+from .._kernel_option import KernelOption
+from ..shapes import hermite
+from .spatial import (PointRule, assemble, axial_energy, check_material_section, clamp_coordinates,
                     hermite_operator, translational_mass)
 
 __all__ = ["Cable3D"]
@@ -137,7 +137,7 @@ class Cable3D(KernelOption, Element):
 
     def _compiled(self, geom, q, tangent):
         """(U, f, K) from the compiled kernel; numba is imported on first use."""
-        from ._cable3d_numba import cable3d_forces
+        from .cable3d_numba import cable3d_forces
         ax, bd = geom["axial"], geom["bend"]
         return cable3d_forces(np.ascontiguousarray(q, dtype=float), _DOF, ax.dN, ax.wdx, geom["slope_ref"],
                               bd.dN, bd.ddN, bd.wdx, self.material.E * self.section.A,

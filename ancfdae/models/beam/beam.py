@@ -16,17 +16,17 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike
 
-from ..loads import DistributedLoad, Gravity, PointForce, PointMoment
-from ..problem import Energy, JacobianBlocks
-from . import _describe
-from ._assembly import Assembler
-from ._beam_checks import BeamChecks
-from ._beam_events import BeamEvents
-from ._beam_loads import BeamLoads
-from ._beam_stages import BeamStages
-from ._element import Element
-from ._mesh import mesh_from_points, straight_mesh
-from ._potential import PotentialMixin
+from ...loads import DistributedLoad, Gravity, PointForce, PointMoment
+from ...problem import Energy, JacobianBlocks
+from . import describe as _describe
+from .assembly import Assembler
+from .checks import BeamChecks
+from .events import BeamEvents
+from .loads import BeamLoads
+from .stages import BeamStages
+from ..element import Element
+from .mesh import mesh_from_points, straight_mesh
+from .potential import PotentialMixin
 
 __all__ = ["Beam"]
 
@@ -34,7 +34,7 @@ __all__ = ["Beam"]
 @functools.cache
 def _finish_residual():
     """The compiled ``f + M a - lambda f_ext`` (imports numba: only reached on the fused path)."""
-    from ._assembly_numba import finish_residual
+    from .assembly_numba import finish_residual
     return finish_residual
 
 

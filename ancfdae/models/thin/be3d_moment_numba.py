@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._be3d_inertia_numba import _spin_vector, spin_scratch
+from .be3d_inertia_numba import _spin_vector, spin_scratch
 
 __all__ = ["be3d_moment"]
 

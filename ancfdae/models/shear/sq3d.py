@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._jet import Jet, combine, cross, dot, mul, recip, sqrt, variables
-from ._sq_common import SQElement, shear_factors
+from ..jets.vector import Jet, combine, cross, dot, mul, recip, sqrt, variables
+from .base import SQElement, shear_factors
 
 __all__ = ["SQ3D"]
 

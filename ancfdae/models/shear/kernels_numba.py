@@ -26,8 +26,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._sq_numba_continuum import continuum_point
-from ._sq_numba_structural import N_JETS, needs_frame, structural_point
+from .continuum_numba import continuum_point
+from .structural_numba import N_JETS, needs_frame, structural_point
 
 __all__ = ["sq_structural", "sq_continuum"]
 

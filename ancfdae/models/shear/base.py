@@ -13,12 +13,12 @@ from typing import Callable
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._validate import choice
-from ..materials import CircularSection, Material, RectangularSection
-from ._element import Element
-from ._quadrature import gauss
-from ._kernel_option import KernelOption
-from ._sq_kernels import assemble, continuum_kernel, local_map, rule, shapes, structural_kernel, voigt
+from ..._validate import choice
+from ...materials import CircularSection, Material, RectangularSection
+from ..element import Element
+from ..._quadrature import gauss
+from .._kernel_option import KernelOption
+from .kernels import assemble, continuum_kernel, local_map, rule, shapes, structural_kernel, voigt
 
 __all__ = ["SQElement", "shear_factors"]
 
@@ -283,7 +283,7 @@ class SQElement(KernelOption, Element):
 
     def _evaluate_numba(self, geom, q, order):
         """The compiled kernel (:mod:`ancfdae.models._sq_numba`); its arrays are built once per geometry."""
-        from . import _sq_numba
+        from . import kernels_numba as _sq_numba
         nbg = geom.get("_numba")
         if nbg is None:
             nbg = geom["_numba"] = _numba_geometry(self.formulation, self.dim, self._stiffness_count(), geom)
@@ -298,7 +298,7 @@ class SQElement(KernelOption, Element):
             return None
         hit = geom.get("_numba_fused")
         if hit is None:
-            from . import _sq_fused_numba as fz
+            from . import fused_numba as fz
             nbg = geom.get("_numba")
             if nbg is None:
                 nbg = geom["_numba"] = _numba_geometry(self.formulation, self.dim, self._stiffness_count(), geom)
@@ -341,7 +341,7 @@ class SQElement(KernelOption, Element):
     def moment_load(self, geom: dict, q: np.ndarray, s: float, moment: np.ndarray, element: int,
                     tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         if self._impl == "numba":
-            from ._sq_numba_moment import sq_moment_load
+            from .moment_numba import sq_moment_load
             f, K = sq_moment_load(np.ascontiguousarray(q, dtype=float), float(s), self.nodes, self.dim,
                                   np.ascontiguousarray(moment, dtype=float), bool(tangent))
             return f, (K if tangent else None)

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._assembly_numba import gather_elements, scatter
+from ..beam.assembly_numba import gather_elements, scatter
 
 __all__ = ["be2d_forces", "be2d_fused", "STRUCTURAL", "CONTINUUM"]
 

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 from numba import njit
 
-from ._assembly_numba import gather_elements, scatter
-from ._sq_numba import sq_continuum, sq_structural
+from ..beam.assembly_numba import gather_elements, scatter
+from .kernels_numba import sq_continuum, sq_structural
 
 __all__ = ["sq_structural_fused", "sq_continuum_fused"]
 

@@ -17,9 +17,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._jet import Jet, combine, variables
-from ._quadrature import gauss
-from ._shapes import linear, quadratic
+from ..jets.vector import Jet, combine, variables
+from ..._quadrature import gauss
+from ..shapes import linear, quadratic
 
 __all__ = ["rule", "local_map", "assemble", "structural_kernel", "continuum_kernel", "voigt"]
 

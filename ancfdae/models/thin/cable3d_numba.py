@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._thin_numba import axial_point, hermite_map, scatter, slope
+from .spatial_numba import axial_point, hermite_map, scatter, slope
 
 __all__ = ["cable3d_forces", "cable3d_element", "cable3d_scratch"]
 

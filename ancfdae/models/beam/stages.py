@@ -7,7 +7,7 @@ import functools
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._validate import check_shape
+from ..._validate import check_shape
 
 __all__ = ["BeamStages"]
 
@@ -15,7 +15,7 @@ __all__ = ["BeamStages"]
 @functools.cache
 def _finish_stages():
     """The compiled stage version of :func:`ancfdae.models.beam._finish_residual`."""
-    from ._assembly_numba import finish_stages
+    from .assembly_numba import finish_stages
     return finish_stages
 
 

@@ -19,12 +19,12 @@ from typing import Callable
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._validate import choice, positive_int
-from ..materials import CircularSection, Material, RectangularSection
-from ._element import Element
-from ._kernel_option import KernelOption
-from ._quadrature import gauss
-from ._shapes import hermite
+from ..._validate import choice, positive_int
+from ...materials import CircularSection, Material, RectangularSection
+from ..element import Element
+from .._kernel_option import KernelOption
+from ..._quadrature import gauss
+from ..shapes import hermite
 
 __all__ = ["BE2D"]
 
@@ -260,7 +260,7 @@ class BE2D(KernelOption, Element):
         """The compiled module and the kernel's arguments after ``q`` (cached in the geometry)."""
         hit = geom.get("_numba")
         if hit is None:   # C-contiguous float copies for the compiled loop, once per geometry
-            from . import _be2d_numba as nb   # imports numba: only once the compiled kernel is selected
+            from . import be2d_numba as nb   # imports numba: only once the compiled kernel is selected
             form = nb.STRUCTURAL if self.formulation == "structural" else nb.CONTINUUM
             E, sec = self.material.E, self.section
             args = tuple(np.ascontiguousarray(geom[k], dtype=float)

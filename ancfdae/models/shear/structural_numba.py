@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._vector_jet_numba import jcross, jdot, jmul, jrecip, jsqrt, jturn, jvar
+from ..jets.vector_numba import jcross, jdot, jmul, jrecip, jsqrt, jturn, jvar
 
 __all__ = ["frame2d", "frame3d", "needs_frame", "N_JETS", "TERMS_2D", "SQUARES_2D", "TERMS_3D", "SQUARES_3D",
            "structural_point"]

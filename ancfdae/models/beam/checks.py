@@ -7,7 +7,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from .._validate import check_shape
+from ..._validate import check_shape
 
 __all__ = ["BeamChecks"]
 

@@ -19,8 +19,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._jet_numba import jlin, jmul, jrecip, jsqrt, jzero
-from ._thin_numba import axial_point, hermite_map, scatter, slope
+from ..jets.scalar_numba import jlin, jmul, jrecip, jsqrt, jzero
+from .spatial_numba import axial_point, hermite_map, scatter, slope
 
 __all__ = ["be3d_forces", "be3d_element", "be3d_scratch", "curvature_point", "N_SLOTS", "K1", "K2", "K3"]
 

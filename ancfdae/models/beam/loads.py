@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..loads import DistributedLoad, Gravity, PointForce, PointMoment
-from ._quadrature import gauss
+from ...loads import DistributedLoad, Gravity, PointForce, PointMoment
+from ..._quadrature import gauss
 
 __all__ = ["BeamLoads"]
 

@@ -17,8 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from .. import materials
-from ._element import Element
+from ... import materials
+from ..element import Element
 
 __all__ = ["describe", "dof_labels", "rebuild", "MODEL_FORMAT"]
 
@@ -124,7 +124,7 @@ def dof_labels(beam) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _element_class(name: str):
-    from . import BE2D, BE3D, SQ2D, SQ3D, Cable3D
+    from .. import BE2D, BE3D, SQ2D, SQ3D, Cable3D
     classes = {cls.name: cls for cls in (BE2D, BE3D, Cable3D, SQ2D, SQ3D)}
     if name not in classes:
         raise ValueError(f"element type must be one of {sorted(classes)}, got {name!r}.")

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._jet import combine, linear, mul, recip, sqrt, dot, variables
-from ._sq_common import SQElement, shear_factors
+from ..jets.vector import combine, linear, mul, recip, sqrt, dot, variables
+from .base import SQElement, shear_factors
 
 __all__ = ["SQ2D"]
 

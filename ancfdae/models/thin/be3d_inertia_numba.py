@@ -19,8 +19,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._jet_numba import jmul, jrecip, jsqrt, jzero
-from ._thin_numba import slope
+from ..jets.scalar_numba import jmul, jrecip, jsqrt, jzero
+from .spatial_numba import slope
 
 __all__ = ["be3d_inertia", "be3d_inertia_element", "inertia_scratch", "be3d_kinetic_energy"]
 

@@ -63,7 +63,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._be3d_kinematics import director_field, frames, spin_coefficients, spin_gradient
+from .be3d_kinematics import director_field, frames, spin_coefficients, spin_gradient
 
 __all__ = ["rotary_inertia", "rotary_kinetic_energy", "update_directors", "director_sines", "UPDATES"]
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._be3d_dynamics import director_sines, update_directors
+from .be3d_inertia import director_sines, update_directors
 
 __all__ = ["BE3DEvents"]
 

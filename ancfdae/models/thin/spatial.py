@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import choice
-from ..materials import Material
-from ._quadrature import gauss
-from ._shapes import hermite
+from ..._validate import choice
+from ...materials import Material
+from ..._quadrature import gauss
+from ..shapes import hermite
 
 __all__ = ["hermite_operator", "PointRule", "axial_energy", "assemble", "translational_mass",
            "check_material_section", "clamp_coordinates", "AXIS_TOL"]

@@ -9,7 +9,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from .._validate import positive_int
+from ._validate import positive_int
 
 __all__ = ["gauss", "gauss_for_order"]
 

@@ -15,8 +15,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._sq_numba_structural import N_JETS, frame2d, frame3d
-from ._vector_jet_numba import jvar
+from .structural_numba import N_JETS, frame2d, frame3d
+from ..jets.vector_numba import jvar
 
 __all__ = ["sq_moment_load"]
 
