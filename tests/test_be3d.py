@@ -42,7 +42,7 @@ def spin_velocity(beam, q, omega):
     V[:, :3] = np.cross(omega, Q[:, :3])
     V[:, 3:6] = np.cross(omega, Q[:, 3:6])
     a = Q[:, 3:6]
-    g = np.stack([j.v for j in spin_coefficients(a, beam.geom["directors"], False)], axis=-1)
+    g = np.stack([j.v for j in spin_coefficients(a, beam.geom["directors"], 1)], axis=-1)
     V[:, 6] = (a / np.linalg.norm(a, axis=1)[:, None]) @ omega - np.einsum("ni,ni->n", g, V[:, 3:6])
     return V.reshape(-1)[beam.free]
 
@@ -349,7 +349,7 @@ def test_residual_path_equals_the_jets():
     a, b, d, dp, k_ref = rng.standard_normal((5, 4, 3, 3))
     th, dth = rng.standard_normal((2, 4, 3))
     D = np.array([1.3, 0.7, 2.1])
-    k = curvatures(a, b, th, dth, d, dp, second=False)
+    k = curvatures(a, b, th, dth, d, dp, order=1)
     W, grad = curvature_energy(a, b, th, dth, d, dp, k_ref, D)
     assert np.allclose(W, 0.5 * sum(D[i] * (k[i].v - k_ref[..., i]) ** 2 for i in range(3)), rtol=1e-13)
     assert rel_err(grad, sum(D[i] * (k[i].v - k_ref[..., i])[..., None] * k[i].g for i in range(3))) < 1e-13

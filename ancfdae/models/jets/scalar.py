@@ -1,25 +1,29 @@
-"""Second-order forward-mode automatic differentiation of scalar expressions ("jets"), with operators.
+"""Scalar jets in NumPy: value, exact gradient and Hessian of scalar expressions over a batch of points.
 
 A :class:`Jet` carries a value and its exact gradient and Hessian with respect
 to ``n`` local variables, for a whole batch of points at once: ``v`` has the
 batch shape ``S`` (e.g. ``(n_el, n_pts)``), ``g`` the shape ``S + (n,)`` and
-``h`` the shape ``S + (n, n)``; ``h`` is None in first-order mode (residuals
-need gradients only, tangents need Hessians too).
+``h`` the shape ``S + (n, n)``. ``order`` 1 propagates gradients only (``h``
+is None: residuals need no Hessians), ``order`` 2 Hessians too.
 
 The BE3D element writes its curvature, twist and cross-section angular
 velocity as short expressions in a few polynomial invariants of the slope
 ``r'`` and its derivative ``r''``; propagating jets through those expressions
 gives the exact first and second derivatives without hand-expanded formulae
-(the model contract asks for exact Jacobians, never finite differences).
-:mod:`._jet` holds the vector-valued, function-style jets of the SQ elements;
-this module overloads the arithmetic operators of scalar jets instead, which
-keeps the BE3D expressions readable as written in the chapter.
+(the model contract asks for exact Jacobians, never finite differences). The
+arithmetic operators are overloaded, so the expressions read as the chapter
+writes them; the functions below are the same operations by name.
+
+The compiled twin :mod:`.scalar_numba` offers ``mul``, ``chain``, ``recip``
+and ``sqrt`` under the same names with the operands in the same order; there a
+jet is a slot of work arrays instead of an object (see
+:mod:`ancfdae.models.jets`).
 """
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["Jet"]
+__all__ = ["Jet", "mul", "recip", "sqrt", "cos", "sin", "chain"]
 
 
 def _outer(a, b):
@@ -27,7 +31,7 @@ def _outer(a, b):
 
 
 class Jet:
-    """Value, gradient and (optionally) Hessian of a scalar field over a batch of points."""
+    """Value ``v``, gradient ``g`` and (for order 2) Hessian ``h`` of a scalar field over a batch of points."""
 
     __slots__ = ("v", "g", "h")
     # Make ``ndarray * Jet`` call Jet.__rmul__ instead of broadcasting over an object.
@@ -39,11 +43,11 @@ class Jet:
         self.h = h
 
     @property
-    def second(self) -> bool:
-        """True when Hessians are propagated."""
-        return self.h is not None
+    def order(self) -> int:
+        """2 when Hessians are propagated, else 1."""
+        return 1 if self.h is None else 2
 
-    # -- arithmetic ---------------------------------------------------------
+    # -- arithmetic: the operators are the functions below --------------------
     def __add__(self, o):
         if isinstance(o, Jet):
             return Jet(self.v + o.v, self.g + o.g, None if self.h is None else self.h + o.h)
@@ -61,51 +65,60 @@ class Jet:
         return (-self) + o
 
     def __mul__(self, o):
-        if isinstance(o, Jet):
-            a, b = self, o
-            g = a.g * b.v[..., None] + b.g * a.v[..., None]
-            h = None
-            if a.h is not None:
-                ab = _outer(a.g, b.g)
-                h = a.h * b.v[..., None, None] + b.h * a.v[..., None, None] + ab + np.swapaxes(ab, -1, -2)
-            return Jet(a.v * b.v, g, h)
-        o = np.asarray(o)
-        return Jet(self.v * o, self.g * o[..., None], None if self.h is None else self.h * o[..., None, None])
+        return mul(self, o)
 
     __rmul__ = __mul__
 
     def __truediv__(self, o):
         if isinstance(o, Jet):
-            return self * o.reciprocal()
-        return self * (1.0 / np.asarray(o))
+            return mul(self, recip(o))
+        return mul(self, 1.0 / np.asarray(o))
 
     def __rtruediv__(self, o):
-        return self.reciprocal() * o
+        return mul(recip(self), o)
 
-    def _chain(self, f0, f1, f2):
-        """Compose with a scalar function given its value and first two derivatives."""
-        g = self.g * f1[..., None]
+
+def mul(a: Jet, b) -> Jet:
+    """``a * b`` of two jets, or of a jet and a constant (array)."""
+    if isinstance(b, Jet):
+        g = a.g * b.v[..., None] + b.g * a.v[..., None]
         h = None
-        if self.h is not None:
-            h = self.h * f1[..., None, None] + _outer(self.g, self.g) * f2[..., None, None]
-        return Jet(f0, g, h)
+        if a.h is not None:
+            ab = _outer(a.g, b.g)
+            h = a.h * b.v[..., None, None] + b.h * a.v[..., None, None] + ab + np.swapaxes(ab, -1, -2)
+        return Jet(a.v * b.v, g, h)
+    b = np.asarray(b)
+    return Jet(a.v * b, a.g * b[..., None], None if a.h is None else a.h * b[..., None, None])
 
-    def reciprocal(self):
-        r = 1.0 / self.v
-        return self._chain(r, -r * r, 2.0 * r * r * r)
 
-    def sqrt(self):
-        s = np.sqrt(self.v)
-        return self._chain(s, 0.5 / s, -0.25 / (s * self.v))
+def chain(a: Jet, f0, f1, f2) -> Jet:
+    """``phi(a)`` for a scalar function with ``phi(a) = f0``, ``phi' = f1``, ``phi'' = f2`` (chain rule)."""
+    g = a.g * f1[..., None]
+    h = None
+    if a.h is not None:
+        h = a.h * f1[..., None, None] + _outer(a.g, a.g) * f2[..., None, None]
+    return Jet(f0, g, h)
 
-    def square(self):
-        return self._chain(self.v * self.v, 2.0 * self.v, np.full_like(self.v, 2.0))
 
-    def cos(self):
-        c, s = np.cos(self.v), np.sin(self.v)
-        return self._chain(c, -s, -c)
+def recip(a: Jet) -> Jet:
+    """``1 / a``."""
+    r = 1.0 / a.v
+    return chain(a, r, -r * r, 2.0 * r * r * r)
 
-    def sin(self):
-        c, s = np.cos(self.v), np.sin(self.v)
-        return self._chain(s, c, -s)
 
+def sqrt(a: Jet) -> Jet:
+    """``sqrt(a)``."""
+    s = np.sqrt(a.v)
+    return chain(a, s, 0.5 / s, -0.25 / (s * a.v))
+
+
+def cos(a: Jet) -> Jet:
+    """``cos(a)``."""
+    c, s = np.cos(a.v), np.sin(a.v)
+    return chain(a, c, -s, -c)
+
+
+def sin(a: Jet) -> Jet:
+    """``sin(a)``."""
+    c, s = np.cos(a.v), np.sin(a.v)
+    return chain(a, s, c, -s)

@@ -1,24 +1,27 @@
-"""Second-order forward-mode differentiation for compiled kernels: scalar jets in slot arrays.
+"""Scalar jets compiled: one point at a time, without allocation, in slots of three work arrays.
 
-The compiled counterpart of :mod:`._scalar_jet`, for one point at a time and
-without allocation: a jet is a *slot* ``k`` of three work arrays, its value
+The compiled twin of :mod:`.scalar`: ``mul``, ``chain``, ``recip`` and ``sqrt``
+carry the NumPy names with the operands in the same order; ``zero`` clears a
+slot and ``lin`` forms ``ca a + cb b`` (what the NumPy twin's operators
+``+`` and ``-`` do). A jet is a *slot* ``k`` of three work arrays: its value
 ``V[k]``, gradient ``G[k, :n]`` and Hessian ``H[k, :n, :n]`` with respect to
-``n`` local variables. Each operation writes slot ``o`` from its operands;
-the Hessian is written first, then the gradient, then the value, so an
-operand may be the output slot. ``second=False`` skips the Hessians
-(residual path).
+``n`` local variables. Each operation writes slot ``o`` from its operands; the
+Hessian is written first, then the gradient, then the value, so an operand may
+be the output slot. ``order`` 1 skips the Hessians (residual path), ``order``
+2 propagates them. Every call reads
+``op(V, G, H, o, <the operands of the NumPy twin>, n, order)``.
 
 The functions are compiled for one explicit signature each: called with
 constant slot numbers, numba would otherwise compile a specialisation per
-distinct constant (it did: ten copies of :func:`jmul`, a third of the first-
-call compile time of the BE3D kernel).
+distinct constant (it did: ten copies of ``mul``, a third of the first-call
+compile time of the BE3D kernel).
 """
 from __future__ import annotations
 
 import numpy as np
 from numba import njit
 
-__all__ = ["jmul", "jlin", "jchain", "jrecip", "jsqrt", "jcos", "jsin", "jconst", "jzero"]
+__all__ = ["zero", "mul", "lin", "chain", "recip", "sqrt"]
 
 _ARR = "float64[::1], float64[:, ::1], float64[:, :, ::1]"
 
@@ -28,30 +31,23 @@ def _sig(*scalars: str) -> str:
     return f"void({_ARR}, {', '.join(scalars)})"
 
 
-@njit(_sig("int64", "int64", "boolean"), cache=True)
-def jzero(V, G, H, o, n, second):
+@njit(_sig("int64", "int64", "int64"), cache=True)
+def zero(V, G, H, o, n, order):
     """Slot ``o`` := 0 (value, gradient and Hessian)."""
     V[o] = 0.0
     for i in range(n):
         G[o, i] = 0.0
-    if second:
+    if order >= 2:
         for i in range(n):
             for j in range(n):
                 H[o, i, j] = 0.0
 
 
-@njit(_sig("int64", "float64", "int64", "boolean"), cache=True)
-def jconst(V, G, H, o, value, n, second):
-    """Slot ``o`` := a constant."""
-    jzero(V, G, H, o, n, second)
-    V[o] = value
-
-
-@njit(_sig("int64", "int64", "int64", "int64", "boolean"), cache=True)
-def jmul(V, G, H, o, a, b, n, second):
+@njit(_sig("int64", "int64", "int64", "int64", "int64"), cache=True)
+def mul(V, G, H, o, a, b, n, order):
     """``o = a * b``."""
     va, vb = V[a], V[b]
-    if second:
+    if order >= 2:
         for i in range(n):
             gai, gbi = G[a, i], G[b, i]
             for j in range(n):
@@ -61,10 +57,10 @@ def jmul(V, G, H, o, a, b, n, second):
     V[o] = va * vb
 
 
-@njit(_sig("int64", "float64", "int64", "float64", "int64", "int64", "boolean"), cache=True)
-def jlin(V, G, H, o, ca, a, cb, b, n, second):
+@njit(_sig("int64", "float64", "int64", "float64", "int64", "int64", "int64"), cache=True)
+def lin(V, G, H, o, ca, a, cb, b, n, order):
     """``o = ca * a + cb * b`` for constants ``ca, cb``."""
-    if second:
+    if order >= 2:
         for i in range(n):
             for j in range(n):
                 H[o, i, j] = ca * H[a, i, j] + cb * H[b, i, j]
@@ -73,10 +69,10 @@ def jlin(V, G, H, o, ca, a, cb, b, n, second):
     V[o] = ca * V[a] + cb * V[b]
 
 
-@njit(_sig("int64", "int64", "float64", "float64", "float64", "int64", "boolean"), cache=True)
-def jchain(V, G, H, o, a, f0, f1, f2, n, second):
+@njit(_sig("int64", "int64", "float64", "float64", "float64", "int64", "int64"), cache=True)
+def chain(V, G, H, o, a, f0, f1, f2, n, order):
     """``o = phi(a)`` for a scalar function with ``phi(a) = f0``, ``phi' = f1``, ``phi'' = f2``."""
-    if second:
+    if order >= 2:
         for i in range(n):
             gi = G[a, i]
             for j in range(n):
@@ -86,29 +82,15 @@ def jchain(V, G, H, o, a, f0, f1, f2, n, second):
     V[o] = f0
 
 
-@njit(_sig("int64", "int64", "int64", "boolean"), cache=True)
-def jrecip(V, G, H, o, a, n, second):
+@njit(_sig("int64", "int64", "int64", "int64"), cache=True)
+def recip(V, G, H, o, a, n, order):
     """``o = 1 / a``."""
     r = 1.0 / V[a]
-    jchain(V, G, H, o, a, r, -r * r, 2.0 * r * r * r, n, second)
+    chain(V, G, H, o, a, r, -r * r, 2.0 * r * r * r, n, order)
 
 
-@njit(_sig("int64", "int64", "int64", "boolean"), cache=True)
-def jsqrt(V, G, H, o, a, n, second):
+@njit(_sig("int64", "int64", "int64", "int64"), cache=True)
+def sqrt(V, G, H, o, a, n, order):
     """``o = sqrt(a)``."""
     s = np.sqrt(V[a])
-    jchain(V, G, H, o, a, s, 0.5 / s, -0.25 / (s * V[a]), n, second)
-
-
-@njit(_sig("int64", "int64", "int64", "boolean"), cache=True)
-def jcos(V, G, H, o, a, n, second):
-    """``o = cos(a)``."""
-    c, s = np.cos(V[a]), np.sin(V[a])
-    jchain(V, G, H, o, a, c, -s, -c, n, second)
-
-
-@njit(_sig("int64", "int64", "int64", "boolean"), cache=True)
-def jsin(V, G, H, o, a, n, second):
-    """``o = sin(a)``."""
-    c, s = np.cos(V[a]), np.sin(V[a])
-    jchain(V, G, H, o, a, s, c, -s, n, second)
+    chain(V, G, H, o, a, s, 0.5 / s, -0.25 / (s * V[a]), n, order)

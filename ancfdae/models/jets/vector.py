@@ -1,4 +1,4 @@
-"""Second-order forward differentiation ("jets") of small vector expressions, vectorised over points.
+"""Vector jets in NumPy: value, exact gradient and Hessian of small vector expressions, over points at once.
 
 The SQ elements need the frame of chapter Eq. 7 and its first *and second*
 derivatives with respect to the cross-section slopes, for exact tangents. The
@@ -7,15 +7,23 @@ reciprocals of at most six variables, so it is propagated here as a jet:
 value ``v`` of shape ``(P, *shape)``, gradient ``g`` ``(P, *shape, K)`` and
 Hessian ``h`` ``(P, *shape, K, K)`` over ``K`` variables, for ``P`` points at
 once (no loop over points). Every rule is the plain product or chain rule, so
-the derivatives are exact to rounding. A jet of order 1 carries no Hessian
-(``h is None``), one of order 0 no gradient either: the residual pays only for
-what it uses.
+the derivatives are exact to rounding. ``order`` says how much is propagated:
+a jet of order 1 carries no Hessian (``h is None``), one of order 0 no
+gradient either: the residual pays only for what it uses.
+
+The compiled twin :mod:`.vector_numba` has the same functions (``variable``,
+``dot``, ``cross``, ``mul``, ``chain``, ``sqrt``, ``recip``, ``turn``) with the
+operands in the same order; ``combine`` is NumPy's only (the compiled kernels
+sum inline).
 """
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["Jet", "variables", "dot", "cross", "mul", "sqrt", "recip", "linear", "combine"]
+__all__ = ["Jet", "variable", "dot", "cross", "mul", "chain", "sqrt", "recip", "turn", "combine"]
+
+# (a_y, -a_x) = TURN a: a 2-vector turned by -90 degrees.
+_TURN = np.array([[0.0, 1.0], [-1.0, 0.0]])
 
 
 class Jet:
@@ -34,31 +42,28 @@ class Jet:
         return Jet(-self.v, None if self.g is None else -self.g, None if self.h is None else -self.h)
 
 
-def variables(*blocks: np.ndarray, order: int = 2) -> list[Jet]:
-    """Vector jets of the independent variables, one per block of shape ``(P, d)``."""
-    P = blocks[0].shape[0]
-    K = sum(b.shape[1] for b in blocks)
-    out, k = [], 0
-    for b in blocks:
-        d = b.shape[1]
-        g = h = None
-        if order >= 1:
-            g = np.zeros((P, d, K))
-            g[:, np.arange(d), k + np.arange(d)] = 1.0
-        if order >= 2:
-            h = np.zeros((P, d, K, K))
-        k += d
-        out.append(Jet(b, g, h))
-    return out
+def variable(x: np.ndarray, x0: int, d: int, first: int, n: int, order: int = 2) -> Jet:
+    """The d-vector jet of the independent variables ``x[:, x0:x0 + d]``, numbered ``first .. first + d - 1`` of ``n``."""
+    block = x[:, x0:x0 + d]
+    P = block.shape[0]
+    g = h = None
+    if order >= 1:
+        g = np.zeros((P, d, n))
+        g[:, np.arange(d), first + np.arange(d)] = 1.0
+    if order >= 2:
+        h = np.zeros((P, d, n, n))
+    return Jet(block, g, h)
 
 
 def _sym(o):
     return o + np.swapaxes(o, -1, -2)
 
 
-def mul(a: Jet, b: Jet) -> Jet:
-    """Scalar jet ``a`` times scalar or vector jet ``b``."""
+def mul(a: Jet, b: Jet, sign: float = 1.0) -> Jet:
+    """``sign * a * b``: scalar jet ``a`` times scalar or vector jet ``b``."""
     e = (slice(None), None) if b.is_vector else (slice(None),)
+    if sign != 1.0:   # exact: a sign flip rounds symmetrically, so this is -(a * b) to the bit
+        a = Jet(sign * a.v, None if a.g is None else sign * a.g, None if a.h is None else sign * a.h)
     av = a.v[e]
     v = av * b.v
     if a.g is None:
@@ -104,28 +109,31 @@ def cross(a: Jet, b: Jet) -> Jet:
     return Jet(v, g, h)
 
 
-def _unary(a: Jet, f, f1, f2) -> Jet:
-    """Chain rule for a scalar function with value f and derivatives f1, f2 at ``a.v``."""
+def chain(a: Jet, f0, f1, f2) -> Jet:
+    """``phi(a)`` of a scalar jet for a function with value ``f0`` and derivatives ``f1``, ``f2`` at ``a``."""
     if a.g is None:
-        return Jet(f)
+        return Jet(f0)
     g = f1[..., None] * a.g
     if a.h is None:
-        return Jet(f, g)
-    return Jet(f, g, f1[..., None, None] * a.h + f2[..., None, None] * a.g[..., :, None] * a.g[..., None, :])
+        return Jet(f0, g)
+    return Jet(f0, g, f1[..., None, None] * a.h + f2[..., None, None] * a.g[..., :, None] * a.g[..., None, :])
 
 
 def sqrt(a: Jet) -> Jet:
+    """``sqrt(a)`` of a scalar jet."""
     r = np.sqrt(a.v)
-    return _unary(a, r, 0.5 / r, -0.25 / (r * a.v))
+    return chain(a, r, 0.5 / r, -0.25 / (r * a.v))
 
 
 def recip(a: Jet) -> Jet:
+    """``1 / a`` of a scalar jet."""
     inv = 1.0 / a.v
-    return _unary(a, inv, -inv**2, 2.0 * inv**3)
+    return chain(a, inv, -inv**2, 2.0 * inv**3)
 
 
-def linear(M: np.ndarray, a: Jet) -> Jet:
-    """Constant matrix ``M`` (d x d) applied to the components of a vector jet."""
+def turn(a: Jet, sign: float) -> Jet:
+    """``sign * (a_y, -a_x)`` of a 2-vector jet: ``a`` turned by -90 degrees (times sign)."""
+    M = sign * _TURN
     return Jet(np.einsum("ij,pj->pi", M, a.v), None if a.g is None else np.einsum("ij,pjk->pik", M, a.g),
                None if a.h is None else np.einsum("ij,pjkl->pikl", M, a.h))
 

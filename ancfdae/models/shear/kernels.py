@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..jets.vector import Jet, combine, variables
+from ..jets import vector as jet
 from ..._quadrature import gauss
 from ..shapes import linear, quadratic
 
@@ -94,7 +94,7 @@ def structural_kernel(strains, which, v: np.ndarray, dim: int, ref: np.ndarray, 
     """
     P = v.shape[0]
     npv = dim * (dim - 1)
-    pj = variables(*[v[:, k * dim:(k + 1) * dim] for k in range(dim - 1)], order=order)
+    pj = [jet.variable(v, k * dim, dim, k * dim, npv, order) for k in range(dim - 1)]
     d = [v[:, npv + j * dim: npv + (j + 1) * dim] for j in range(dim)]
     comps = strains(pj, which)
     raw = np.stack([sum(np.einsum("pc,pc->p", c.v, d[j]) for j, c in terms) + (s.v if s is not None else 0.0)
@@ -121,14 +121,14 @@ def structural_kernel(strains, which, v: np.ndarray, dim: int, ref: np.ndarray, 
         ks = [(k, c) for k, (terms, _) in enumerate(comps) for jj, c in terms if jj == j]
         if not ks:
             continue
-        wj = combine([sig[:, k] for k, _ in ks], [c for _, c in ks])
+        wj = jet.combine([sig[:, k] for k, _ in ks], [c for _, c in ks])
         H[:, :npv, :npv] += np.einsum("pc,pckl->pkl", d[j], wj.h)
         blk = np.swapaxes(wj.g, 1, 2)                 # (P, n_p, dim)
         H[:, :npv, npv + j * dim: npv + (j + 1) * dim] += blk
         H[:, npv + j * dim: npv + (j + 1) * dim, :npv] += np.swapaxes(blk, 1, 2)
     quad = [(k, s) for k, (_, s) in enumerate(comps) if s is not None]
     if quad:
-        H[:, :npv, :npv] += combine([sig[:, k] for k, _ in quad], [s for _, s in quad]).h
+        H[:, :npv, :npv] += jet.combine([sig[:, k] for k, _ in quad], [s for _, s in quad]).h
     return W, g, H, eps
 
 

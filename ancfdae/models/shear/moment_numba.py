@@ -16,7 +16,7 @@ import numpy as np
 from numba import njit
 
 from .structural_numba import N_JETS, frame2d, frame3d
-from ..jets.vector_numba import jvar
+from ..jets import vector_numba as jet
 
 __all__ = ["sq_moment_load"]
 
@@ -41,8 +41,8 @@ def sq_moment_load(qe, s, nodes, dim, moment, tangent):
     fp = np.zeros(npv)
     Kp = np.zeros((npv, npv))
     if dim == 3:
-        jvar(p, 0, 3, 0, JV, JG, JH, 0, order)
-        jvar(p, 3, 3, 3, JV, JG, JH, 1, order)
+        jet.variable(JV, JG, JH, 0, p, 0, 3, 0, order)
+        jet.variable(JV, JG, JH, 1, p, 3, 3, 3, order)
         frame3d(JV, JG, JH, order, True)
         M = moment
         for e in (10, 11, 5):                              # e1, e2, e3
@@ -62,7 +62,7 @@ def sq_moment_load(qe, s, nodes, dim, moment, tangent):
                         Kp[k, l] += 0.5 * (w0 * JH[e, 0, k, l] + w1 * JH[e, 1, k, l] + w2 * JH[e, 2, k, l]
                                            + JG[e, 0, k] * m0 + JG[e, 1, k] * m1 + JG[e, 2, k] * m2)
     else:
-        jvar(p, 0, 2, 0, JV, JG, JH, 0, order)
+        jet.variable(JV, JG, JH, 0, p, 0, 2, 0, order)
         frame2d(JV, JG, JH, order, True)
         Mz = moment[2]
         for k in range(2):

@@ -9,13 +9,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..jets.vector import combine, linear, mul, recip, sqrt, dot, variables
+from ..jets import vector as jet
 from .base import SQElement, shear_factors
 
 __all__ = ["SQ2D"]
 
-# e_1 = (e_2y, -e_2x): e_2 turned by -90 degrees, so that (e_1, e_2, e_z) is right-handed.
-_TURN = np.array([[0.0, 1.0], [-1.0, 0.0]])
 
 
 class SQ2D(SQElement):
@@ -72,18 +70,19 @@ class SQ2D(SQElement):
     def _strains(p, which):
         """``(terms, s)`` of Gamma_1, Gamma_2, kappa, E_22 (those in ``which``); blocks 0 = r', 1 = a'."""
         a = p[0]
-        aa = dot(a, a)
-        out = {3: ([], combine([np.full(aa.v.shape, 0.5)], [aa]))}
+        aa = jet.dot(a, a)
+        out = {3: ([], jet.combine([np.full(aa.v.shape, 0.5)], [aa]))}
         if any(k < 3 for k in which):
-            e2 = mul(recip(sqrt(aa)), a)
-            # (a x a').e_z / |a|^2 = a' . (-TURN a) / |a|^2
-            out.update({0: ([(0, linear(_TURN, e2))], None), 1: ([(0, e2)], None),
-                        2: ([(1, mul(recip(aa), linear(-_TURN, a)))], None)})
+            e2 = jet.mul(jet.recip(jet.sqrt(aa)), a)
+            # e_1 = (e_2y, -e_2x): e_2 turned by -90 degrees, so that (e_1, e_2, e_z) is right-handed;
+            # (a x a').e_z / |a|^2 = a' . (-a_y, a_x) / |a|^2
+            out.update({0: ([(0, jet.turn(e2, 1.0))], None), 1: ([(0, e2)], None),
+                        2: ([(1, jet.mul(jet.recip(aa), jet.turn(a, -1.0)))], None)})
         return [out[k] for k in which]
 
     def _rotation_force(self, p, moment):
         """Planar dead moment: ``delta phi = (a x delta a).e_z / |a|^2`` of the slope ``a = x_eta``."""
-        (a,) = variables(p[None, :])
-        g = mul(recip(dot(a, a)), linear(-_TURN, a))
+        a = jet.variable(p[None, :], 0, 2, 0, 2)
+        g = jet.mul(jet.recip(jet.dot(a, a)), jet.turn(a, -1.0))
         Mz = float(moment[2])
         return Mz * g.v[0], Mz * g.g[0]

@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..jets.vector import Jet, combine, cross, dot, mul, recip, sqrt, variables
+from ..jets import vector as jet
+from ..jets.vector import Jet
 from .base import SQElement, shear_factors
 
 __all__ = ["SQ3D"]
@@ -21,13 +22,13 @@ def frame(a2: Jet, a3: Jet) -> tuple[Jet, Jet, Jet, Jet, Jet, Jet]:
     Returns the jets ``e1, e2, e3`` and the scalars ``m = |a3|``,
     ``n = |a2 x a3|``, ``t = a2 . e3`` used by the curvature.
     """
-    m = sqrt(dot(a3, a3))
-    e3 = mul(recip(m), a3)
-    c = cross(a2, a3)
-    n = sqrt(dot(c, c))
-    e1 = mul(recip(n), c)
-    e2 = cross(e3, e1)
-    return e1, e2, e3, m, n, dot(a2, e3)
+    m = jet.sqrt(jet.dot(a3, a3))
+    e3 = jet.mul(jet.recip(m), a3)
+    c = jet.cross(a2, a3)
+    n = jet.sqrt(jet.dot(c, c))
+    e1 = jet.mul(jet.recip(n), c)
+    e2 = jet.cross(e3, e1)
+    return e1, e2, e3, m, n, jet.dot(a2, e3)
 
 
 class SQ3D(SQElement):
@@ -94,19 +95,20 @@ class SQ3D(SQElement):
         """
         a2, a3 = p
         half = np.full(a2.v.shape[0], 0.5)
-        out = {6: ([], combine([half], [dot(a2, a2)])), 7: ([], combine([half], [dot(a3, a3)])),
-               8: ([], dot(a2, a3))}
+        out = {6: ([], jet.combine([half], [jet.dot(a2, a2)])), 7: ([], jet.combine([half], [jet.dot(a3, a3)])),
+               8: ([], jet.dot(a2, a3))}
         if any(k < 6 for k in which):
             e1, e2, e3, m, n, t = frame(a2, a3)
-            im, inn = recip(m), recip(n)
+            im, inn = jet.recip(m), jet.recip(n)
             out.update({0: ([(0, e1)], None), 1: ([(0, e2)], None), 2: ([(0, e3)], None),
-                        3: ([(2, -mul(im, e2))], None), 4: ([(2, mul(im, e1))], None),
-                        5: ([(1, -mul(mul(m, inn), e1)), (2, mul(mul(t, inn), e1))], None)})
+                        3: ([(2, jet.mul(im, e2, -1.0))], None), 4: ([(2, jet.mul(im, e1))], None),
+                        5: ([(1, jet.mul(jet.mul(m, inn), e1, -1.0)), (2, jet.mul(jet.mul(t, inn), e1))], None)})
         return [out[k] for k in which]
 
     def _rotation_force(self, p, moment):
         """``G^T M`` and its derivative for ``delta phi = 1/2 e_i x delta e_i`` (Sect. 2.2), frame of Eq. 7."""
-        a2, a3 = variables(p[None, :3], p[None, 3:])
+        x = p[None, :]
+        a2, a3 = jet.variable(x, 0, 3, 0, 6), jet.variable(x, 3, 3, 3, 6)
         M = moment
         f = np.zeros(6)
         K = np.zeros((6, 6))

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..jets.vector_numba import jcross, jdot, jmul, jrecip, jsqrt, jturn, jvar
+from ..jets import vector_numba as jet
 
 __all__ = ["frame2d", "frame3d", "needs_frame", "N_JETS", "TERMS_2D", "SQUARES_2D", "TERMS_3D", "SQUARES_3D",
            "structural_point"]
@@ -47,43 +47,43 @@ def frame3d(JV, JG, JH, order, need_frame):
     11 e2, 12 t = a2.e3, 13 -e2/m, 14 e1/m, 15 m/n, 16 -(m/n) e1, 17 t/n, 18 (t/n) e1,
     19 a2.a2, 21 a2.a3.
     """
-    jdot(3, JV, JG, JH, 1, 1, 2, order)
-    jdot(3, JV, JG, JH, 0, 0, 19, order)
-    jdot(3, JV, JG, JH, 0, 1, 21, order)
+    jet.dot(JV, JG, JH, 2, 1, 1, 3, order)
+    jet.dot(JV, JG, JH, 19, 0, 0, 3, order)
+    jet.dot(JV, JG, JH, 21, 0, 1, 3, order)
     if not need_frame:
         return
-    jsqrt(JV, JG, JH, 2, 3, order)
-    jrecip(JV, JG, JH, 3, 4, order)
-    jmul(1.0, 3, JV, JG, JH, 4, 1, 5, order)
-    jcross(JV, JG, JH, 0, 1, 6, order)
-    jdot(3, JV, JG, JH, 6, 6, 7, order)
-    jsqrt(JV, JG, JH, 7, 8, order)
-    jrecip(JV, JG, JH, 8, 9, order)
-    jmul(1.0, 3, JV, JG, JH, 9, 6, 10, order)
-    jcross(JV, JG, JH, 5, 10, 11, order)
-    jdot(3, JV, JG, JH, 0, 5, 12, order)
-    jmul(-1.0, 3, JV, JG, JH, 4, 11, 13, order)
-    jmul(1.0, 3, JV, JG, JH, 4, 10, 14, order)
-    jmul(1.0, 1, JV, JG, JH, 3, 9, 15, order)
-    jmul(-1.0, 3, JV, JG, JH, 15, 10, 16, order)
-    jmul(1.0, 1, JV, JG, JH, 12, 9, 17, order)
-    jmul(1.0, 3, JV, JG, JH, 17, 10, 18, order)
+    jet.sqrt(JV, JG, JH, 3, 2, order)
+    jet.recip(JV, JG, JH, 4, 3, order)
+    jet.mul(JV, JG, JH, 5, 4, 1, 1.0, 3, order)
+    jet.cross(JV, JG, JH, 6, 0, 1, order)
+    jet.dot(JV, JG, JH, 7, 6, 6, 3, order)
+    jet.sqrt(JV, JG, JH, 8, 7, order)
+    jet.recip(JV, JG, JH, 9, 8, order)
+    jet.mul(JV, JG, JH, 10, 9, 6, 1.0, 3, order)
+    jet.cross(JV, JG, JH, 11, 5, 10, order)
+    jet.dot(JV, JG, JH, 12, 0, 5, 3, order)
+    jet.mul(JV, JG, JH, 13, 4, 11, -1.0, 3, order)
+    jet.mul(JV, JG, JH, 14, 4, 10, 1.0, 3, order)
+    jet.mul(JV, JG, JH, 15, 3, 9, 1.0, 1, order)
+    jet.mul(JV, JG, JH, 16, 15, 10, -1.0, 3, order)
+    jet.mul(JV, JG, JH, 17, 12, 9, 1.0, 1, order)
+    jet.mul(JV, JG, JH, 18, 17, 10, 1.0, 3, order)
 
 
 @njit(**_OPTS)
 def frame2d(JV, JG, JH, order, need_frame):
     """Jets of the planar frame: rows 0 a, 1 a.a, 2 |a|, 3 1/|a|, 4 e2, 5 turn(e2), 6 1/a.a,
     7 (-a_y, a_x), 8 (-a_y, a_x)/a.a."""
-    jdot(2, JV, JG, JH, 0, 0, 1, order)
+    jet.dot(JV, JG, JH, 1, 0, 0, 2, order)
     if not need_frame:
         return
-    jsqrt(JV, JG, JH, 1, 2, order)
-    jrecip(JV, JG, JH, 2, 3, order)
-    jmul(1.0, 2, JV, JG, JH, 3, 0, 4, order)
-    jturn(1.0, JV, JG, JH, 4, 5, order)
-    jrecip(JV, JG, JH, 1, 6, order)
-    jturn(-1.0, JV, JG, JH, 0, 7, order)
-    jmul(1.0, 2, JV, JG, JH, 6, 7, 8, order)
+    jet.sqrt(JV, JG, JH, 2, 1, order)
+    jet.recip(JV, JG, JH, 3, 2, order)
+    jet.mul(JV, JG, JH, 4, 3, 0, 1.0, 2, order)
+    jet.turn(JV, JG, JH, 5, 4, 1.0, order)
+    jet.recip(JV, JG, JH, 6, 1, order)
+    jet.turn(JV, JG, JH, 7, 0, -1.0, order)
+    jet.mul(JV, JG, JH, 8, 6, 7, 1.0, 2, order)
 
 
 @njit(**_OPTS)
@@ -113,12 +113,12 @@ def structural_point(dim, v, Dw, ref, JV, JG, JH, eps, sig, Jm, g, H, order):
     nk = Dw.shape[0]
     need_frame = needs_frame(dim, Dw)
     if dim == 3:
-        jvar(v, 0, 3, 0, JV, JG, JH, 0, order)
-        jvar(v, 3, 3, 3, JV, JG, JH, 1, order)
+        jet.variable(JV, JG, JH, 0, v, 0, 3, 0, order)
+        jet.variable(JV, JG, JH, 1, v, 3, 3, 3, order)
         frame3d(JV, JG, JH, order, need_frame)
         terms, squares = TERMS_3D, SQUARES_3D
     else:
-        jvar(v, 0, 2, 0, JV, JG, JH, 0, order)
+        jet.variable(JV, JG, JH, 0, v, 0, 2, 0, order)
         frame2d(JV, JG, JH, order, need_frame)
         terms, squares = TERMS_2D, SQUARES_2D
     nt = terms.shape[0] if need_frame else 0

@@ -18,6 +18,7 @@ from .be3d_directors import BE3DEvents
 from .be3d_kinematics import curvature_energy, curvatures, director_field, frames, spin_gradient
 from ..element import Element
 from .._kernel_option import KernelOption
+from ..jets import scalar as jet
 from ..jets.scalar import Jet
 from ..shapes import hermite, linear
 from .spatial import (PointRule, assemble, axial_energy, check_material_section, clamp_coordinates,
@@ -208,7 +209,7 @@ class BE3D(KernelOption, BE3DEvents, Element):
             rule = geom[key]
             d, _ = director_field(geom["directors"], rule)
             _check_director(d.reshape(-1, 3), np.einsum("epin,en->epi", rule.Ba, q_ref).reshape(-1, 3))
-        geom["k_ref"] = np.stack([k.v for k in self._curvatures(geom, q_ref, None)], axis=-1)
+        geom["k_ref"] = np.stack([k.v for k in self._curvatures(geom, q_ref, 1)], axis=-1)
         return geom
 
     def _fallback_directors(self, q_ref):
@@ -233,13 +234,13 @@ class BE3D(KernelOption, BE3DEvents, Element):
         dth = np.einsum("epn,en->ep", rule.dNt, q)
         return a, b, th, dth, d, np.broadcast_to(dp, d.shape)
 
-    def _curvatures(self, geom, q, second, rule=None):
-        return curvatures(*self._local(geom, q, geom["bend"] if rule is None else rule), second=bool(second))
+    def _curvatures(self, geom, q, order, rule=None):
+        return curvatures(*self._local(geom, q, geom["bend"] if rule is None else rule), order=order)
 
     def curvature(self, geom: dict, q: np.ndarray, s: ArrayLike) -> np.ndarray:
         """Twist and curvatures ``(k1, k2, k3)`` per xi at normalised coordinates ``s``, shape (n_el, n_pts, 3)."""
         rule = self._rule(np.atleast_1d(np.asarray(s, dtype=float)), geom["L"])
-        return np.stack([k.v for k in self._curvatures(geom, q, False, rule)], axis=-1)
+        return np.stack([k.v for k in self._curvatures(geom, q, 1, rule)], axis=-1)
 
     def spin(self, geom: dict, q: np.ndarray, v: np.ndarray, s: ArrayLike) -> np.ndarray:
         """Angular velocity of the cross-section about the axis, ``omega . e1``, shape (n_el, n_pts)."""
@@ -286,7 +287,7 @@ class BE3D(KernelOption, BE3DEvents, Element):
             return f + np.einsum("epvn,epv->en", rule.Bx, grad * rule.wdx[..., None]), None
         grad = 0.0
         hess = 0.0
-        for i, ki in enumerate(self._curvatures(geom, q, True)):
+        for i, ki in enumerate(self._curvatures(geom, q, 2)):
             wi = self.D[i] * rule.wdx
             ri = (ki.v - geom["k_ref"][..., i]) * wi
             grad = grad + ri[..., None] * ki.g
@@ -333,7 +334,7 @@ class BE3D(KernelOption, BE3DEvents, Element):
         a = Sx @ q
         I = np.eye(3)
         aj = [Jet(a[i], I[i]) for i in range(3)]
-        sp = (aj[0] * aj[0] + aj[1] * aj[1] + aj[2] * aj[2]).sqrt()
+        sp = jet.sqrt(aj[0] * aj[0] + aj[1] * aj[1] + aj[2] * aj[2])
         e1 = [x / sp for x in aj]
         Me1 = M[0] * e1[0] + M[1] * e1[1] + M[2] * e1[2]
         Mxe1 = [M[1] * e1[2] - M[2] * e1[1], M[2] * e1[0] - M[0] * e1[2], M[0] * e1[1] - M[1] * e1[0]]

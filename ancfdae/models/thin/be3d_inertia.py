@@ -73,11 +73,11 @@ UPDATES = ("projected", "post-rotated", "none")
 _SINGULAR = 1e-12
 
 
-def _spin_parts(rule, geom, q, second):
+def _spin_parts(rule, geom, q, order):
     a = np.einsum("epin,en->epi", rule.Ba, q)
     d, _ = director_field(geom["directors"], rule)
-    if second:
-        gj = spin_coefficients(a, d, True)
+    if order >= 2:
+        gj = spin_coefficients(a, d, 2)
         g = np.stack([j.v for j in gj], axis=-1)              # (n_el, n_pts, 3)
         G = np.stack([j.g for j in gj], axis=-2)              # (..., 3, 3): G[i, k] = dg_i/da_k
         H = np.stack([j.h for j in gj], axis=-3)              # (..., 3, 3, 3)
@@ -89,14 +89,14 @@ def _spin_parts(rule, geom, q, second):
 
 def rotary_kinetic_energy(rule, geom, q, v, rhoJ):
     """``1/2 int rho J omega1^2 dxi`` per element, shape (n_el,)."""
-    *_, w = _spin_parts(rule, geom, q, False)
+    *_, w = _spin_parts(rule, geom, q, 1)
     om = np.einsum("epn,en->ep", w, v)
     return 0.5 * rhoJ * np.sum(rule.wdx * om**2, axis=1)
 
 
-def rotary_inertia(rule, geom, q, v, acc, rhoJ, jacobian=True):
+def rotary_inertia(rule, geom, q, v, acc, rhoJ, tangent=True):
     """Rotary inertia force ``f_rot`` and, if asked, ``df/dq``, ``df/dv``, ``df/da`` (module docstring)."""
-    a, g, G, H, w = _spin_parts(rule, geom, q, jacobian)
+    a, g, G, H, w = _spin_parts(rule, geom, q, 2 if tangent else 1)
     Ba = rule.Ba
     ad = np.einsum("epin,en->epi", Ba, v)                     # a_dot
     om = np.einsum("epn,en->ep", w, v)                        # omega1
@@ -106,7 +106,7 @@ def rotary_inertia(rule, geom, q, v, acc, rhoJ, jacobian=True):
     c = np.einsum("epin,epi->epn", Ba, Aad)
     W = rhoJ * rule.wdx
     f = np.einsum("ep,epn->en", W, w * Om[..., None] + om[..., None] * c)
-    if not jacobian:
+    if not tangent:
         return f, None, None, None
     outer = lambda x, y: x[..., :, None] * y[..., None, :]   # noqa: E731
     Wm = W[..., None, None]

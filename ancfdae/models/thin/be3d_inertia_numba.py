@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..jets.scalar_numba import jmul, jrecip, jsqrt, jzero
+from ..jets import scalar_numba as jet
 from .spatial_numba import slope
 
 __all__ = ["be3d_inertia", "be3d_inertia_element", "inertia_scratch", "be3d_kinetic_energy"]
@@ -28,18 +28,18 @@ _P, _AD, _M2, _SP, _W, _R, _C = range(7)
 
 
 @njit(cache=True, inline="always")
-def spin_scratch(second):
-    """Work arrays of :func:`_spin_vector`: jet slots (V, G, H), a 3-vector and a 3x3 matrix."""
-    return np.zeros(7), np.zeros((7, 3)), np.zeros((7 if second else 1, 3, 3)), np.zeros(3), np.zeros((3, 3))
+def spin_scratch(order):
+    """Work arrays of :func:`spin_vector`: jet slots (V, G, H), a 3-vector and a 3x3 matrix."""
+    return np.zeros(7), np.zeros((7, 3)), np.zeros((7 if order >= 2 else 1, 3, 3)), np.zeros(3), np.zeros((3, 3))
 
 
 # Explicit signatures: one compilation each (constant flags would otherwise each get their own).
 _V3, _M33, _T333 = "float64[::1]", "float64[:, ::1]", "float64[:, :, ::1]"
 
 
-@njit(f"void({_V3}, {_V3}, {_V3}, {_M33}, {_T333}, boolean, {_V3}, {_M33}, {_T333}, {_V3}, {_M33})", cache=True)
-def _spin_vector(a, d, g, Gm, Hg, second, V, G, H, m, dm):
-    """``g(a)``, ``G = dg/da`` and, if ``second``, ``Hg[i, j, k] = d2 g_i / da_j da_k`` at one point.
+@njit(f"void({_V3}, {_V3}, {_V3}, {_M33}, {_T333}, int64, {_V3}, {_M33}, {_T333}, {_V3}, {_M33})", cache=True)
+def spin_vector(a, d, g, Gm, Hg, order, V, G, H, m, dm):
+    """``g(a)``, ``G = dg/da`` and, for ``order`` 2, ``Hg[i, j, k] = d2 g_i / da_j da_k`` at one point.
 
     ``V, G, H, m, dm``: work arrays from :func:`spin_scratch`.
     """
@@ -49,7 +49,7 @@ def _spin_vector(a, d, g, Gm, Hg, second, V, G, H, m, dm):
     dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
     ad = a[0] * d[0] + a[1] * d[1] + a[2] * d[2]
     for o in (_P, _AD, _M2):
-        jzero(V, G, H, o, 3, second)
+        jet.zero(V, G, H, o, 3, order)
     V[_P] = a[0] * a[0] + a[1] * a[1] + a[2] * a[2]
     V[_AD] = ad
     V[_M2] = m[0] * m[0] + m[1] * m[1] + m[2] * m[2]
@@ -57,14 +57,14 @@ def _spin_vector(a, d, g, Gm, Hg, second, V, G, H, m, dm):
         G[_P, i] = 2.0 * a[i]
         G[_AD, i] = d[i]
         G[_M2, i] = 2.0 * (dd * a[i] - ad * d[i])
-        if second:
+        if order >= 2:
             H[_P, i, i] = 2.0
             for j in range(3):
                 H[_M2, i, j] = 2.0 * ((dd if i == j else 0.0) - d[i] * d[j])
-    jsqrt(V, G, H, _SP, _P, 3, second)
-    jmul(V, G, H, _W, _SP, _M2, 3, second)
-    jrecip(V, G, H, _R, _W, 3, second)
-    jmul(V, G, H, _C, _AD, _R, 3, second)
+    jet.sqrt(V, G, H, _SP, _P, 3, order)
+    jet.mul(V, G, H, _W, _SP, _M2, 3, order)
+    jet.recip(V, G, H, _R, _W, 3, order)
+    jet.mul(V, G, H, _C, _AD, _R, 3, order)
     # dm/da = [d]_x
     dm[0, 1], dm[0, 2] = -d[2], d[1]
     dm[1, 0], dm[1, 2] = d[2], -d[0]
@@ -74,7 +74,7 @@ def _spin_vector(a, d, g, Gm, Hg, second, V, G, H, m, dm):
         g[i] = c * m[i]
         for j in range(3):
             Gm[i, j] = G[_C, j] * m[i] + c * dm[i, j]
-            if second:
+            if order >= 2:
                 for k in range(3):
                     Hg[i, j, k] = H[_C, j, k] * m[i] + G[_C, j] * dm[i, k] + G[_C, k] * dm[i, j]
 
@@ -99,13 +99,13 @@ def _bat_m_ba(out, dof, dN, M, scale):
 
 
 @njit(cache=True, inline="always")
-def _point_state(q, dof, theta, dN, l0, l1, dA, dB, a, d, w, g, Gm, Hg, second, scratch):
+def _point_state(q, dof, theta, dN, l0, l1, dA, dB, a, d, w, g, Gm, Hg, order, scratch):
     """Slope ``a``, director ``d``, ``g, G, Hg`` and the spin row ``w = N_theta + Ba^T g`` at a point."""
     slope(q, dof, dN, a)
     for i in range(3):
         d[i] = l0 * dA[i] + l1 * dB[i]
     V, G, H, m, dm = scratch
-    _spin_vector(a, d, g, Gm, Hg, second, V, G, H, m, dm)
+    spin_vector(a, d, g, Gm, Hg, order, V, G, H, m, dm)
     w[:] = 0.0
     w[theta[0]] = l0
     w[theta[1]] = l1
@@ -113,16 +113,16 @@ def _point_state(q, dof, theta, dN, l0, l1, dA, dB, a, d, w, g, Gm, Hg, second, 
 
 
 @njit(cache=True, inline="always")
-def inertia_scratch(n, jacobian):
+def inertia_scratch(n, tangent):
     """Work arrays of :func:`be3d_inertia_element` for ``n`` element coordinates."""
     return ((np.empty(3), np.empty(3), np.empty(3), np.empty((3, 3)), np.empty((3, 3, 3)), np.empty(3),
              np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty((3, 3))),
-            (np.empty(n), np.empty(n), np.empty(n), np.empty(n)), spin_scratch(jacobian))
+            (np.empty(n), np.empty(n), np.empty(n), np.empty(n)), spin_scratch(2 if tangent else 1))
 
 
 @njit(cache=True, inline="always")
-def be3d_inertia_element(f, Kq, Dv, Ma, q, v, acc, dof, theta, dN, wdx, lin, dA, dB, rhoJ, jacobian, work):
-    """One element: adds the rotary inertia force to ``f`` (14,) and, if ``jacobian``, df/dq, df/dv, df/da.
+def be3d_inertia_element(f, Kq, Dv, Ma, q, v, acc, dof, theta, dN, wdx, lin, dA, dB, rhoJ, tangent, work):
+    """One element: adds the rotary inertia force to ``f`` (14,) and, if ``tangent``, df/dq, df/dv, df/da.
 
     ``work`` from :func:`inertia_scratch`.
     """
@@ -130,7 +130,7 @@ def be3d_inertia_element(f, Kq, Dv, Ma, q, v, acc, dof, theta, dN, wdx, lin, dA,
     (a, d, g, Gm, Hg, ad, add, Gad, x, y, M3), (w, c, t, u), scratch = work
     for p in range(wdx.size):
         W = rhoJ * wdx[p]
-        _point_state(q, dof, theta, dN[p], lin[p, 0], lin[p, 1], dA, dB, a, d, w, g, Gm, Hg, jacobian, scratch)
+        _point_state(q, dof, theta, dN[p], lin[p, 0], lin[p, 1], dA, dB, a, d, w, g, Gm, Hg, 2 if tangent else 1, scratch)
         slope(v, dof, dN[p], ad)                       # a_dot
         om = 0.0
         wacc = 0.0
@@ -151,7 +151,7 @@ def be3d_inertia_element(f, Kq, Dv, Ma, q, v, acc, dof, theta, dN, wdx, lin, dA,
         _bat(c, dof, dN[p], x, 1.0)
         for r in range(n):
             f[r] += W * (w[r] * Om + om * c[r])
-        if not jacobian:
+        if not tangent:
             continue
         for r in range(n):
             for s_ in range(n):
@@ -198,25 +198,25 @@ def be3d_inertia_element(f, Kq, Dv, Ma, q, v, acc, dof, theta, dN, wdx, lin, dA,
 
 
 @njit(cache=True)
-def be3d_inertia(q, v, acc, dof, theta, dN, wdx, lin, directors, rhoJ, jacobian):
-    """Rotary inertia force (n_el, 14) and, if ``jacobian``, df/dq, df/dv, df/da (n_el, 14, 14) each.
+def be3d_inertia(q, v, acc, dof, theta, dN, wdx, lin, directors, rhoJ, tangent):
+    """Rotary inertia force (n_el, 14) and, if ``tangent``, df/dq, df/dv, df/da (n_el, 14, 14) each.
 
     ``dN`` (n_el, n_pts, 4), ``wdx`` (n_el, n_pts), ``lin`` (n_pts, 2): the
-    inertia rule; ``directors`` (n_el + 1, 3). Without ``jacobian`` the three
+    inertia rule; ``directors`` (n_el + 1, 3). Without ``tangent`` the three
     blocks have shape (0, 14, 14).
     """
     n_el, n = q.shape
     f = np.zeros((n_el, n))
-    m = n_el if jacobian else 1
+    m = n_el if tangent else 1
     Kq = np.zeros((m, n, n))
     Dv = np.zeros((m, n, n))
     Ma = np.zeros((m, n, n))
-    work = inertia_scratch(n, jacobian)
+    work = inertia_scratch(n, tangent)
     for e in range(n_el):
-        j = e if jacobian else 0
+        j = e if tangent else 0
         be3d_inertia_element(f[e], Kq[j], Dv[j], Ma[j], q[e], v[e], acc[e], dof, theta, dN[e], wdx[e], lin,
-                             directors[e], directors[e + 1], rhoJ, jacobian, work)
-    if not jacobian:
+                             directors[e], directors[e + 1], rhoJ, tangent, work)
+    if not tangent:
         return f, Kq[:0], Dv[:0], Ma[:0]
     return f, Kq, Dv, Ma
 
@@ -232,11 +232,11 @@ def be3d_kinetic_energy(q, v, dof, theta, dN, wdx, lin, directors, rhoJ):
     Gm = np.empty((3, 3))
     Hg = np.empty((1, 3, 3))
     w = np.empty(n)
-    scratch = spin_scratch(False)
+    scratch = spin_scratch(1)
     for e in range(n_el):
         for p in range(wdx.shape[1]):
             _point_state(q[e], dof, theta, dN[e, p], lin[p, 0], lin[p, 1], directors[e], directors[e + 1],
-                         a, d, w, g, Gm, Hg, False, scratch)
+                         a, d, w, g, Gm, Hg, 1, scratch)
             om = 0.0
             for r in range(n):
                 om += w[r] * v[e, r]

@@ -23,13 +23,14 @@ updates). With ``p = a.a``, ``m = d x a``, ``m2 = |m|^2``:
 
       omega1 = theta_dot + g(a) . a_dot,   g(a) = (a.d) m / (|a| m2).
 
-All quantities are returned as :class:`~ancfdae.models._scalar_jet.Jet` objects with
+All quantities are returned as :class:`~ancfdae.models.jets.scalar.Jet` objects with
 exact derivatives with respect to the local variables.
 """
 from __future__ import annotations
 
 import numpy as np
 
+from ..jets import scalar as jet
 from ..jets.scalar import Jet
 
 __all__ = ["curvatures", "curvature_energy", "spin_coefficients", "spin_gradient", "frames", "director_field",
@@ -52,20 +53,20 @@ def _dot(u, v):
     return u[..., 0] * v[..., 0] + u[..., 1] * v[..., 1] + u[..., 2] * v[..., 2]
 
 
-def _jet(v, n, second, grads, hess=()):
+def _jet(v, n, order, grads, hess=()):
     """Build a jet from its value and sparse gradient/Hessian blocks ``(slice, array)``."""
     g = np.zeros(v.shape + (n,))
     for sl, val in grads:
         g[..., sl] = val
     h = None
-    if second:
+    if order >= 2:
         h = np.zeros(v.shape + (n, n))
         for (si, sj), val in hess:
             h[..., si, sj] = val
     return Jet(v, g, h)
 
 
-def _invariants(a, b, d, dp, n, second, with_b=True):
+def _invariants(a, b, d, dp, n, order, with_b=True):
     """Polynomial invariants as jets over ``(a[, b, theta, theta'])`` (variables a: 0:3, b: 3:6)."""
     A, B = slice(0, 3), slice(3, 6)
     I = np.eye(3)
@@ -74,23 +75,23 @@ def _invariants(a, b, d, dp, n, second, with_b=True):
     ad = dot(a, d)
     m = cross(d, a)
     out = {
-        "p": _jet(dot(a, a), n, second, [(A, 2.0 * a)], [((A, A), 2.0 * I)]),
-        "ad": _jet(ad, n, second, [(A, d)]),
-        "m2": _jet(dot(m, m), n, second, [(A, 2.0 * (dd[..., None] * a - ad[..., None] * d))],
+        "p": _jet(dot(a, a), n, order, [(A, 2.0 * a)], [((A, A), 2.0 * I)]),
+        "ad": _jet(ad, n, order, [(A, d)]),
+        "m2": _jet(dot(m, m), n, order, [(A, 2.0 * (dd[..., None] * a - ad[..., None] * d))],
                    [((A, A), 2.0 * (dd[..., None, None] * I - d[..., :, None] * d[..., None, :]))]),
     }
     if with_b:
         # b.(d x a) = a.(b x d); d2/(da_i db_j) = (e_j x d)_i = EPS[i, j, k] d_k
         Hab = np.einsum("ijk,...k->...ij", EPS, d)
-        out["ab"] = _jet(dot(a, b), n, second, [(A, b), (B, a)], [((A, B), I), ((B, A), I)])
-        out["bd"] = _jet(dot(b, d), n, second, [(B, d)])
-        out["t"] = _jet(dot(b, m), n, second, [(A, cross(b, d)), (B, m)],
+        out["ab"] = _jet(dot(a, b), n, order, [(A, b), (B, a)], [((A, B), I), ((B, A), I)])
+        out["bd"] = _jet(dot(b, d), n, order, [(B, d)])
+        out["t"] = _jet(dot(b, m), n, order, [(A, cross(b, d)), (B, m)],
                         [((A, B), Hab), ((B, A), np.swapaxes(Hab, -1, -2))])
-        out["tp"] = _jet(dot(dp, m), n, second, [(A, cross(dp, d))])
+        out["tp"] = _jet(dot(dp, m), n, order, [(A, cross(dp, d))])
     return out
 
 
-def curvatures(a, b, theta, dtheta, d, dp, second=True):
+def curvatures(a, b, theta, dtheta, d, dp, order=2):
     """Twist and curvatures ``(k1, k2, k3)`` per xi as jets over ``(a, b, theta, theta')`` (8 variables).
 
     Parameters
@@ -99,16 +100,16 @@ def curvatures(a, b, theta, dtheta, d, dp, second=True):
     its xi-derivative; d, dp : (..., 3) director and its xi-derivative.
     """
     n = 8
-    inv = _invariants(a, b, d, dp, n, second)
+    inv = _invariants(a, b, d, dp, n, order)
     p, ad, m2, ab, bd, t, tp = (inv[k] for k in ("p", "ad", "m2", "ab", "bd", "t", "tp"))
-    th = _jet(theta, n, second, [(6, 1.0)])
-    thp = _jet(dtheta, n, second, [(7, 1.0)])
-    sp = p.sqrt()
-    sm = m2.sqrt()
+    th = _jet(theta, n, order, [(6, 1.0)])
+    thp = _jet(dtheta, n, order, [(7, 1.0)])
+    sp = jet.sqrt(p)
+    sm = jet.sqrt(m2)
     X = t / (sm * sp)
     Y = (bd * p - ab * ad) / (p * sm)
     tau0 = (p * tp - ad * t) / (sp * m2)
-    c, s = th.cos(), th.sin()
+    c, s = jet.cos(th), jet.sin(th)
     return thp - tau0, s * X - c * Y, c * X + s * Y
 
 
@@ -167,19 +168,19 @@ def spin_gradient(a, d):
     return g, G
 
 
-def spin_coefficients(a, d, second=True):
+def spin_coefficients(a, d, order=2):
     """The vector ``g(a) = (a.d)(d x a) / (|a| |d x a|^2)`` of ``omega1 = theta_dot + g . a_dot``.
 
     Returns three jets over ``a`` (3 variables): ``G = dg/da`` are their
     gradients and ``H = d2g/da2`` their Hessians.
     """
-    inv = _invariants(a, None, d, None, 3, second, with_b=False)
+    inv = _invariants(a, None, d, None, 3, order, with_b=False)
     p, ad, m2 = inv["p"], inv["ad"], inv["m2"]
-    coef = ad / (p.sqrt() * m2)
+    coef = ad / (jet.sqrt(p) * m2)
     m = cross(d, a)
     # d(d x a)_j / da_k = EPS[j, l, k] d_l
     dm = np.einsum("jlk,...l->...jk", EPS, d)
-    zero = np.zeros(a.shape[:-1] + (3, 3)) if second else None
+    zero = np.zeros(a.shape[:-1] + (3, 3)) if order >= 2 else None
     return [coef * Jet(m[..., j], dm[..., j, :], zero) for j in range(3)]
 
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .be3d_inertia_numba import _spin_vector, spin_scratch
+from .be3d_inertia_numba import spin_scratch, spin_vector
 
 __all__ = ["be3d_moment"]
 
@@ -43,8 +43,8 @@ def be3d_moment(q, dof, theta, s, L, dA, dB, M, tangent):
     g = np.empty(3)
     Gm = np.empty((3, 3))
     Hg = np.empty((1, 3, 3))
-    V, G, H, m, dm = spin_scratch(False)
-    _spin_vector(a, d, g, Gm, Hg, False, V, G, H, m, dm)
+    V, G, H, m, dm = spin_scratch(1)
+    spin_vector(a, d, g, Gm, Hg, 1, V, G, H, m, dm)
     p = a[0] * a[0] + a[1] * a[1] + a[2] * a[2]
     sp = np.sqrt(p)
     Me1 = (M[0] * a[0] + M[1] * a[1] + M[2] * a[2]) / sp

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..jets.scalar_numba import jlin, jmul, jrecip, jsqrt, jzero
+from ..jets import scalar_numba as jet
 from .spatial_numba import axial_point, hermite_map, scatter, slope
 
 __all__ = ["be3d_forces", "be3d_element", "be3d_scratch", "curvature_point", "N_SLOTS", "K1", "K2", "K3"]
@@ -31,7 +31,7 @@ N_LOC = 8
 
 
 @njit(cache=True)
-def curvature_point(V, G, H, a, b, th, thp, d, dp, second):
+def curvature_point(V, G, H, a, b, th, thp, d, dp, order):
     """Jets of ``(k1, k2, k3)`` over ``(a, b, theta, theta')`` in slots K1, K2, K3 (8 variables).
 
     ``X``, ``Y`` and ``tau0`` depend on ``(a, b)`` only: their jets run over
@@ -41,7 +41,7 @@ def curvature_point(V, G, H, a, b, th, thp, d, dp, second):
     """
     n = 6
     for o in (P, AD, M2, AB, BD, T, TP):
-        jzero(V, G, H, o, n, second)
+        jet.zero(V, G, H, o, n, order)
     m0 = d[1] * a[2] - d[2] * a[1]          # m = d x a
     m1 = d[2] * a[0] - d[0] * a[2]
     m2 = d[0] * a[1] - d[1] * a[0]
@@ -69,7 +69,7 @@ def curvature_point(V, G, H, a, b, th, thp, d, dp, second):
         G[AB, i] = b[i]
         G[AB, 3 + i] = a[i]
         G[BD, 3 + i] = d[i]
-    if second:
+    if order >= 2:
         for i in range(3):
             H[P, i, i] = 2.0
             H[AB, i, 3 + i] = 1.0
@@ -83,30 +83,30 @@ def curvature_point(V, G, H, a, b, th, thp, d, dp, second):
         H[T, 0, 5] = H[T, 5, 0] = -d[1]
         H[T, 1, 5] = H[T, 5, 1] = d[0]
         H[T, 2, 4] = H[T, 4, 2] = -d[0]
-    jsqrt(V, G, H, SP, P, n, second)
-    jsqrt(V, G, H, SM, M2, n, second)
+    jet.sqrt(V, G, H, SP, P, n, order)
+    jet.sqrt(V, G, H, SM, M2, n, order)
     # X = t / (|m| |a|)
-    jmul(V, G, H, W1, SM, SP, n, second)
-    jrecip(V, G, H, R1, W1, n, second)
-    jmul(V, G, H, X, T, R1, n, second)
+    jet.mul(V, G, H, W1, SM, SP, n, order)
+    jet.recip(V, G, H, R1, W1, n, order)
+    jet.mul(V, G, H, X, T, R1, n, order)
     # Y = (b.d p - (a.b)(a.d)) / (p |m|)
-    jmul(V, G, H, N1, BD, P, n, second)
-    jmul(V, G, H, N2, AB, AD, n, second)
-    jlin(V, G, H, NY, 1.0, N1, -1.0, N2, n, second)
-    jmul(V, G, H, W2, P, SM, n, second)
-    jrecip(V, G, H, R2, W2, n, second)
-    jmul(V, G, H, Y, NY, R2, n, second)
+    jet.mul(V, G, H, N1, BD, P, n, order)
+    jet.mul(V, G, H, N2, AB, AD, n, order)
+    jet.lin(V, G, H, NY, 1.0, N1, -1.0, N2, n, order)
+    jet.mul(V, G, H, W2, P, SM, n, order)
+    jet.recip(V, G, H, R2, W2, n, order)
+    jet.mul(V, G, H, Y, NY, R2, n, order)
     # tau0 = (p d'.m - (a.d) t) / (|a| |m|^2)
-    jmul(V, G, H, N3, P, TP, n, second)
-    jmul(V, G, H, N4, AD, T, n, second)
-    jlin(V, G, H, NT, 1.0, N3, -1.0, N4, n, second)
-    jmul(V, G, H, W1, SP, M2, n, second)
-    jrecip(V, G, H, R3, W1, n, second)
-    jmul(V, G, H, TAU, NT, R3, n, second)
+    jet.mul(V, G, H, N3, P, TP, n, order)
+    jet.mul(V, G, H, N4, AD, T, n, order)
+    jet.lin(V, G, H, NT, 1.0, N3, -1.0, N4, n, order)
+    jet.mul(V, G, H, W1, SP, M2, n, order)
+    jet.recip(V, G, H, R3, W1, n, order)
+    jet.mul(V, G, H, TAU, NT, R3, n, order)
     # k1 = theta' - tau0, k2 = s X - c Y, k3 = c X + s Y over (a, b, theta, theta')
     c, s = np.cos(th), np.sin(th)
     for o in (K1, K2, K3):
-        jzero(V, G, H, o, N_LOC, second)
+        jet.zero(V, G, H, o, N_LOC, order)
     vx, vy = V[X], V[Y]
     V[K1] = thp - V[TAU]
     V[K2] = s * vx - c * vy
@@ -118,7 +118,7 @@ def curvature_point(V, G, H, a, b, th, thp, d, dp, second):
         G[K1, i] = -G[TAU, i]
         G[K2, i] = s * G[X, i] - c * G[Y, i]
         G[K3, i] = c * G[X, i] + s * G[Y, i]
-    if second:
+    if order >= 2:
         for i in range(n):
             h2 = c * G[X, i] + s * G[Y, i]          # d2 k2 / (d x_i d theta)
             h3 = -s * G[X, i] + c * G[Y, i]         # d2 k3 / (d x_i d theta)
@@ -164,7 +164,7 @@ def be3d_element(f, K, q, dof, theta, dNa, wa, slope_ref, dNb, ddNb, wb, lin, L,
             d[i] = l0 * dA[i] + l1 * dB[i]
         th = l0 * q[theta[0]] + l1 * q[theta[1]]
         thp = (q[theta[1]] - q[theta[0]]) / L
-        curvature_point(V, G, H, a, b, th, thp, d, dp, tangent)
+        curvature_point(V, G, H, a, b, th, thp, d, dp, 2 if tangent else 1)
         for v in range(N_LOC):
             grad[v] = 0.0
             for u in range(N_LOC):
