@@ -1,4 +1,4 @@
-"""The element interface that :class:`ancfdae.models.Beam` assembles.
+"""The element contract that :class:`ancfdae.models.Beam` assembles, the registry of element types and the kernel option.
 
 An element type is a class with a few class attributes describing its node
 layout and methods that work on *all elements at once*: element coordinate
@@ -21,15 +21,76 @@ Conventions
   element precomputes for a mesh (reference lengths, shape functions at the
   quadrature points, reference strains, constant mass matrices, directors);
   the beam passes it back to every kernel call.
+* Registry: every subclass that sets its own ``name`` is registered under it
+  (:meth:`Element.by_name`), so that a result file, which records the name,
+  can rebuild a user's element as well as the built-in ones.
+* Kernel option: an element with a NumPy reference and a compiled twin of its
+  kernels lists both in ``kernel_twins``; setting ``kernel`` builds one
+  :class:`Kernel` object, which the element's kernel methods call. The choice
+  is made once, never per call.
 """
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Mapping
 from typing import Any, Callable, ClassVar
 
 import numpy as np
 
-__all__ = ["Element"]
+from .._validate import choice
+
+__all__ = ["Element", "Kernel", "KERNELS", "resolve_kernel"]
+
+#: Values of the ``kernel`` option.
+KERNELS = ("auto", "numba", "numpy")
+
+# Element types by name (filled by Element.__init_subclass__).
+_REGISTRY: dict[str, type] = {}
+
+
+def resolve_kernel(kernel: str) -> str:
+    """The implementation a ``kernel`` option selects: "numba" (compiled) or "numpy" (the reference).
+
+    ``"auto"``, the default, is the compiled kernel: numba is a dependency of
+    ancfdae (``import ancfdae`` imports it), so there is nothing to fall back
+    from; the value stays accepted because result files record it.
+    """
+    return "numpy" if choice("kernel", kernel, KERNELS) == "numpy" else "numba"
+
+
+class Kernel:
+    """One implementation of an element's kernels: the NumPy reference or its compiled twin.
+
+    A subclass implements the element methods that have two implementations,
+    with the element's signatures (e.g. ``internal_forces(geom, q, tangent)``);
+    the element's own methods call the kernel object its ``kernel`` option built.
+    The NumPy reference sits in the element's module ``x.py``, the compiled
+    twin in ``x_numba.py``.
+
+    Parameters
+    ----------
+    element : Element
+        The element whose material, section and options the kernels read.
+
+    Attributes
+    ----------
+    name : str
+        ``"numpy"`` or ``"numba"``: what :attr:`Element.kernel_in_use` reports.
+    """
+
+    name: ClassVar[str] = "numpy"
+
+    def __init__(self, element: Element) -> None:
+        self.element = element
+
+    def fused(self, geom: Any) -> tuple[Callable, tuple] | None:
+        """The fused assembly entry point ``(fn, args)`` (see :meth:`Element.fused_kernel`); None here.
+
+        Only a compiled kernel offers one; the NumPy reference assembles with
+        ``np.bincount``, which is also the path that the tests hold the fused
+        one equal to.
+        """
+        return None
 
 
 class Element(ABC):
@@ -60,11 +121,21 @@ class Element(ABC):
     section : RectangularSection or CircularSection
         Instance attribute, required: the beam reads ``A`` from it.
 
+    kernel_twins : dict
+        ``{"numpy": factory, "numba": factory}``, each factory taking the
+        element and returning its :class:`Kernel`; empty (the default) for an
+        element with one implementation, which then has no ``kernel`` option.
+    kernels : Kernel
+        Instance attribute of an element with ``kernel_twins``: the kernel
+        object that the ``kernel`` option selected.
+
     Notes
     -----
-    The attributes up to ``energy_degree`` are class attributes. Subclasses
+    The attributes up to ``kernel_twins`` are class attributes. Subclasses
     keep every constructor option under its argument name, so that
-    :meth:`Beam.describe` records it and a result file can rebuild the element.
+    :meth:`Beam.describe` records it and a result file can rebuild the element;
+    a subclass that sets its own ``name`` is registered under it
+    (:meth:`by_name`).
     """
 
     name: ClassVar[str]
@@ -74,6 +145,54 @@ class Element(ABC):
     mass_is_constant: ClassVar[bool] = True
     formulations: ClassVar[tuple[str, ...]] = ("structural",)
     energy_degree: ClassVar[int | None] = None
+    kernel_twins: ClassVar[Mapping[str, Callable[[Element], Kernel]]] = {}
+
+    def __init_subclass__(cls, **kwargs) -> None:
+        super().__init_subclass__(**kwargs)
+        name = cls.__dict__.get("name")
+        if name is None:   # an abstract base, or a variant that keeps its parent's name
+            return
+        known = _REGISTRY.get(name)
+        if known is not None and (known.__module__, known.__qualname__) != (cls.__module__, cls.__qualname__):
+            raise TypeError(f"element `name` {name!r} is taken by {known.__module__}.{known.__qualname__}; "
+                            f"give {cls.__qualname__} a name of its own.")
+        _REGISTRY[name] = cls   # a class defined again (a re-run script) replaces its earlier self
+
+    @staticmethod
+    def by_name(name: str) -> type[Element]:
+        """The element type registered under ``name`` (the ``name`` a result file records).
+
+        Raises
+        ------
+        ValueError
+            If no element type of that name has been defined (imported) yet.
+        """
+        if name not in _REGISTRY:
+            raise ValueError(f"element type must be one of {sorted(_REGISTRY)}, got {name!r} (an element type "
+                             "is known once its class has been defined: import it first).")
+        return _REGISTRY[name]
+
+    # -- the kernel option ----------------------------------------------------
+    @property
+    def kernel(self) -> str:
+        """The ``kernel`` option as given: "auto" (compiled, the default), "numba" or "numpy".
+
+        Setting it (also later, on a built beam's element) builds the kernel
+        object :attr:`kernels` once (:func:`resolve_kernel`).
+        """
+        return self._kernel
+
+    @kernel.setter
+    def kernel(self, value: str) -> None:
+        if not self.kernel_twins:
+            raise AttributeError(f"{type(self).__name__} has one implementation of its kernels: it takes no `kernel`.")
+        self.kernels = self.kernel_twins[resolve_kernel(value)](self)
+        self._kernel = value
+
+    @property
+    def kernel_in_use(self) -> str:
+        """The implementation that runs: "numba" or "numpy"."""
+        return self.kernels.name
 
     @property
     def n_nodes(self) -> int:
@@ -118,9 +237,19 @@ class Element(ABC):
         done by fixing coordinates (the cantilever of chapter Sect. 5.1).
         """
 
+    def reference_state(self, points: np.ndarray, frames: np.ndarray) -> dict:
+        """The event state of the undeformed configuration (BE3D: its nodal directors); none by default.
+
+        The beam passes it to :meth:`prepare` as keyword arguments.
+        """
+        return {}
+
     @abstractmethod
-    def prepare(self, q_ref: np.ndarray, lengths: np.ndarray) -> Any:
+    def prepare(self, q_ref: np.ndarray, lengths: np.ndarray, **state: Any) -> Any:
         """Precompute everything that depends on the mesh only.
+
+        The beam passes the event state of :meth:`reference_state` as keyword
+        arguments (BE3D: ``directors``); most elements take none.
 
         Parameters
         ----------
@@ -187,24 +316,27 @@ class Element(ABC):
 
     # -- optional: fused compiled assembly ----------------------------------
     def fused_kernel(self, geom: Any) -> tuple[Callable, tuple] | None:
-        """The element's fused gather-kernel-scatter entry point, or None (the default).
+        """The element's fused gather-kernel-scatter entry point, or None.
 
-        An element with a compiled kernel returns ``(fn, args)``; the beam then
-        assembles the internal forces and tangent by the single call
-        ``fn(q, q_fixed, gather, vec_slot, mat_slot, tangent, r, kdata, *args)``
-        (the contract is in :mod:`ancfdae.models._assembly_numba`), which must
-        give the same arrays as :meth:`internal_forces` followed by the beam's
-        scatter. ``geom`` may be the geometry of stacked copies of the mesh.
+        A compiled kernel object may return ``(fn, args)`` (:meth:`Kernel.fused`);
+        the beam then assembles the internal forces and tangent by the single
+        call ``fn(q, q_fixed, gather, vec_slot, mat_slot, tangent, r, kdata,
+        *args)`` (the contract is in :mod:`ancfdae.models.beam.assembly_numba`),
+        which must give the same arrays as :meth:`internal_forces` followed by
+        the beam's ``np.bincount`` scatter. With None (the NumPy kernel, an
+        element with one implementation, or a subclass that returns None) the
+        beam takes that NumPy path. ``geom`` may be the geometry of stacked
+        copies of the mesh.
         """
-        return None
+        return self.kernels.fused(geom) if self.kernel_twins else None
 
     # -- optional: configuration-dependent inertia (BE3D) ------------------
-    def inertia(self, geom: Any, q: np.ndarray, v: np.ndarray, a: np.ndarray, jacobian: bool = True) -> tuple:
+    def inertia(self, geom: Any, q: np.ndarray, v: np.ndarray, a: np.ndarray, tangent: bool = True) -> tuple:
         """Inertia forces beyond the constant mass matrix.
 
         Only for ``mass_is_constant = False``: returns ``f`` of shape
         (n_el, n_edof) such that the element's inertia force is
-        ``M_const a + f``, and if ``jacobian`` the blocks ``df/dq``, ``df/dv``,
+        ``M_const a + f``, and if ``tangent`` the blocks ``df/dq``, ``df/dv``,
         ``df/da`` of shape (n_el, n_edof, n_edof).
         """
         raise NotImplementedError

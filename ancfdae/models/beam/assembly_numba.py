@@ -13,7 +13,7 @@ and, if ``tangent``, ``K`` of shape (n_el, n_edof, n_edof)), and sums them with
 bin receives the entries of fixed coordinates and is dropped. Entries are
 added in element order starting from zero, which is exactly what
 ``np.bincount`` does in the NumPy assembly, so both give the same bits for the
-same element arrays. See ``_be2d_numba.be2d_fused`` for the template.
+same element arrays. See :func:`ancfdae.models.thin.be2d_numba.be2d_fused` for the template.
 
 numba's on-disk cache is keyed on the source file of the cached function only, and a fused entry
 point holds a compiled copy of the kernel it calls: after editing a kernel in another file, delete the

@@ -3,10 +3,16 @@
 :func:`describe` turns a :class:`~ancfdae.models.Beam` into a JSON-able dict
 (element type and options, material, section, mesh, supports, loads);
 :func:`dof_labels` names each free coordinate by its node and coordinate name;
-:func:`rebuild` makes the beam again from the dict, for the tools that read a
-result file without the script that made it (``ancfdae export vtk``,
-``ancfdae animate``). Loads are recorded by their ``repr`` only: their time
+:func:`beam_arguments` reads the dict back into the element and the keyword
+arguments of the beam, which :meth:`ancfdae.models.Beam.from_description`
+builds, for the tools that read a result file without the script that made it
+(``ancfdae export vtk``, ``ancfdae animate``). The element type is looked up by name in the registry of
+:class:`~ancfdae.models.Element`, so a user's element rebuilds too once its
+class is defined. Loads are recorded by their ``repr`` only: their time
 functions are Python callables, and the geometry tools need none of them.
+
+The functions take the beam as an argument and never import it: this module
+sits below the beam.
 """
 from __future__ import annotations
 
@@ -20,7 +26,7 @@ import numpy as np
 from ... import materials
 from ..element import Element
 
-__all__ = ["describe", "dof_labels", "rebuild", "MODEL_FORMAT"]
+__all__ = ["describe", "dof_labels", "beam_arguments", "MODEL_FORMAT"]
 
 #: Version tag of the dict that :func:`describe` returns.
 MODEL_FORMAT = "ancfdae.Beam/1"
@@ -123,14 +129,6 @@ def dof_labels(beam) -> tuple[np.ndarray, np.ndarray]:
     return beam.free // nnd, names[beam.free % nnd]
 
 
-def _element_class(name: str):
-    from .. import BE2D, BE3D, SQ2D, SQ3D, Cable3D
-    classes = {cls.name: cls for cls in (BE2D, BE3D, Cable3D, SQ2D, SQ3D)}
-    if name not in classes:
-        raise ValueError(f"element type must be one of {sorted(classes)}, got {name!r}.")
-    return classes[name]
-
-
 def _from_record(record: dict, allowed: tuple):
     classes = {cls.__name__: cls for cls in allowed}
     kind = record.get("type")
@@ -139,8 +137,8 @@ def _from_record(record: dict, allowed: tuple):
     return classes[kind](**{k: v for k, v in record.items() if k != "type"})
 
 
-def rebuild(description: dict):
-    """Make the beam of a :func:`describe` dict again, without its loads.
+def beam_arguments(description: dict) -> tuple[Element, dict]:
+    """The element and the :class:`~ancfdae.models.Beam` keyword arguments of a :func:`describe` dict.
 
     Parameters
     ----------
@@ -149,9 +147,12 @@ def rebuild(description: dict):
 
     Returns
     -------
-    Beam
-        Same element, material, section, nodes and supports, hence the same
-        coordinates and reference configuration; no loads.
+    element : Element
+        Same type (looked up with :meth:`Element.by_name`), options, material
+        and section.
+    kwargs : dict
+        ``nodes``, ``normal`` and ``supports``: with the element they make the
+        same coordinates and reference configuration; no loads.
 
     Raises
     ------
@@ -159,11 +160,10 @@ def rebuild(description: dict):
         If the dict is not a beam description or names an unknown element,
         material or section type.
     """
-    from .beam import Beam
     if not isinstance(description, dict) or description.get("format") != MODEL_FORMAT:
         got = description.get("format") if isinstance(description, dict) else type(description).__name__
         raise ValueError(f"`description` must be a beam description of format {MODEL_FORMAT!r}, got {got!r}.")
-    cls = _element_class(description["element"]["type"])
+    cls = Element.by_name(description["element"]["type"])
     material = _from_record(description["material"], (materials.Material,))
     section = _from_record(description["section"], (materials.RectangularSection, materials.CircularSection))
     options = dict(description["element"]["options"])
@@ -172,4 +172,4 @@ def rebuild(description: dict):
     nodes = np.array(description["nodes"], dtype=float)
     if nodes.ndim != 2 or not all(math.isfinite(x) for x in nodes.ravel()):
         raise ValueError(f"`nodes` of the description must be a finite 2-D array, got shape {nodes.shape}.")
-    return Beam(element, nodes=nodes, normal=description.get("normal"), supports=supports)
+    return element, {"nodes": nodes, "normal": description.get("normal"), "supports": supports}

@@ -1,11 +1,13 @@
-"""Reference geometry of a beam: node positions, cross-section frames, element lengths."""
+"""Reference geometry of a beam: node positions, cross-section frames, element lengths, and the numbering
+of nodes and coordinates along the axis (banded matrices)."""
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..._validate import finite_vector, positive, positive_int
 
-__all__ = ["straight_mesh", "mesh_from_points", "frame_from_tangent"]
+__all__ = ["build", "numbering", "point_matrix", "straight_mesh", "mesh_from_points", "frame_from_tangent"]
 
 
 def frame_from_tangent(e1: np.ndarray, normal=None) -> np.ndarray:
@@ -77,3 +79,54 @@ def mesh_from_points(points, nodes_per_element, normal=None):
     ends = p[:: nodes_per_element - 1]
     lengths = np.linalg.norm(np.diff(ends, axis=0), axis=1)
     return p, frames, lengths
+
+
+def build(element, n_elements=None, length=None, start=None, direction=None, nodes=None, normal=None):
+    """Points, frames and element lengths of the mesh that :class:`~ancfdae.models.Beam`'s arguments describe:
+    ``nodes`` (a curved or irregular beam) or ``n_elements`` and ``length`` (a straight one)."""
+    dim, npe = element.dim, element.n_nodes
+    if nodes is not None:
+        if n_elements is not None or length is not None:
+            raise ValueError("give either `nodes` or `n_elements` and `length`, not both.")
+        points, frames, lengths = mesh_from_points(nodes, npe, normal)
+        if points.shape[1] != dim:
+            raise ValueError(f"`nodes` must have {dim} columns for {element.name}, got {points.shape[1]}.")
+        return points, frames, lengths
+    if n_elements is None or length is None:
+        raise ValueError("give `n_elements` and `length` (or `nodes`).")
+    start = np.zeros(dim) if start is None else start
+    direction = np.eye(dim)[0] if direction is None else direction
+    if np.size(start) != dim:
+        raise ValueError(f"`start` must have {dim} components for {element.name}, got {np.size(start)}.")
+    return straight_mesh(n_elements, length, start, direction, npe, normal)
+
+
+def numbering(lengths: np.ndarray, nodes_per_element: int, node_dof: int) -> tuple:
+    """``(element_nodes, edofs, s_nodes)``: the nodes of each element, its full coordinate indices and the
+    reference arc length of each node.
+
+    Nodes are numbered along the axis, so the matrices are banded; a 3-node
+    element orders its nodes (A, B, C) = (start, end, middle) (chapter Eq. 105).
+    """
+    n_el = lengths.size
+    k = nodes_per_element - 1
+    base = np.arange(n_el)[:, None] * k
+    order = [0, k] + list(range(1, k))
+    element_nodes = base + np.array(order)[None, :]
+    edofs = (element_nodes[:, :, None] * node_dof + np.arange(node_dof)).reshape(n_el, -1)
+    s_nodes = np.concatenate([[0.0], np.cumsum(np.repeat(lengths / k, k))])
+    return element_nodes, edofs, s_nodes
+
+
+def point_matrix(element, edofs: np.ndarray, lengths: np.ndarray, e: np.ndarray, loc: np.ndarray,
+                 n_full: int) -> sp.csr_matrix:
+    """Sparse operator P with ``r = P @ q_full`` at the axis points ``loc`` (normalised) of elements ``e``."""
+    dim, nd = element.dim, element.n_edof
+    rows, cols, vals = [], [], []
+    for k, (ek, sk) in enumerate(zip(e, loc)):   # a few sensor points, at construction only
+        S = element.shape_matrix(np.array([sk]), lengths[[ek]])[0, 0]
+        rows.append(np.repeat(np.arange(dim) + k * dim, nd))
+        cols.append(np.tile(edofs[ek], dim))
+        vals.append(S.ravel())
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(len(e) * dim, n_full))

@@ -1,48 +1,74 @@
-"""Stacked-stage residuals of a :class:`~ancfdae.models.beam.Beam`: the residuals of several stages from
-one element pass over the stages' elements stacked (the optional ``residual_stages`` Model method)."""
+"""The stage evaluator of a :class:`~ancfdae.models.Beam`: the residuals of several stages from one element
+pass over the stages' elements stacked (the optional ``residual_stages`` Model method, which Lobatto IIIA
+uses); it halves the per-call overhead of small meshes."""
 from __future__ import annotations
 
 import functools
 
 import numpy as np
-from numpy.typing import ArrayLike
 
-from ..._validate import check_shape
+from .assembly import Assembler
 
-__all__ = ["BeamStages"]
+__all__ = ["StageEvaluator"]
 
 
 @functools.cache
 def _finish_stages():
-    """The compiled stage version of :func:`ancfdae.models.beam._finish_residual`."""
+    """The compiled ``F + M A - lambda F_ext`` of the stages (imports numba: only reached on the fused path)."""
     from .assembly_numba import finish_stages
     return finish_stages
 
 
-class BeamStages:
-    """Stage methods of :class:`~ancfdae.models.beam.Beam` (a mixin: it uses the beam's element, assembler
-    and the fused entry point)."""
+class StageEvaluator:
+    """Residuals ``F(Q) + M A - lambda F_ext`` of ``m`` stages of a constant-mass beam in one element pass.
 
-    def residual_stages(self, ts: ArrayLike, Q: np.ndarray, V: np.ndarray, A: np.ndarray) -> np.ndarray:
-        """Residuals of several stages in one element pass: column ``i`` of the (n_dof, m) result is
-        ``residual(ts[i], Q[:, i], V[:, i], A[:, i])`` (optional Model method; Lobatto IIIA uses it).
+    The element kernel runs once on the stages' elements stacked: a geometry
+    for ``m`` copies of the mesh, prepared on first use of each ``m``. With a
+    fused entry point of the element (:meth:`ancfdae.models.Element.fused_kernel`)
+    gather, kernel, scatter and the residual run compiled; else NumPy gathers
+    and ``np.bincount`` scatters (the same sums in the same order).
 
-        The element kernel runs once on the stages' elements stacked (a geometry for ``m`` copies of
-        the mesh, prepared on first use), which halves the per-call overhead of small meshes.
-        """
-        m = np.size(ts)
-        if np.ndim(ts) != 1 or np.shape(Q) != (self.n_dof, m) or np.shape(V) != (self.n_dof, m) \
-                or np.shape(A) != (self.n_dof, m):
-            check_shape("ts", ts, (m,), "one time per stage")
-            for name, X in (("Q", Q), ("V", V), ("A", A)):
-                check_shape(name, X, (self.n_dof, m), f"(n_dof, number of stages) = ({self.n_dof}, {m})")
-        ts = np.asarray(ts, dtype=float)
-        m = ts.size
-        if not self.mass_is_constant:
-            return np.column_stack([self.residual(ts[i], Q[:, i], V[:, i], A[:, i]) for i in range(m)])
-        geom, gather, idx = self._stage_geometry(m)
-        n = self.n_dof
-        fused = self._fused(geom)
+    Parameters
+    ----------
+    element : Element
+    q_ref_elements : ndarray (n_el, n_edof)
+        Element coordinates of the reference configuration.
+    lengths : ndarray (n_el,)
+    gather : ndarray (n_el, n_edof)
+        Index of each element coordinate in ``(free q, fixed values)``.
+    q_fixed : ndarray
+        Reference values of the fixed coordinates.
+    assembler : Assembler
+    mass_data : ndarray
+        CSR data of the constant mass matrix (pattern of ``assembler``).
+    """
+
+    def __init__(self, element, q_ref_elements: np.ndarray, lengths: np.ndarray, gather: np.ndarray,
+                 q_fixed: np.ndarray, assembler: Assembler, mass_data: np.ndarray) -> None:
+        self.element = element
+        self._q_ref_elements, self._lengths = q_ref_elements, lengths
+        self._gather, self._q_fixed = gather, q_fixed
+        self._asm = assembler
+        self._mass_data = mass_data
+        self._mass_csr = assembler.csr(mass_data)
+        self._no_k = np.empty(1)
+        self._cache = {}
+
+    def _stacked(self, m):
+        """Element geometry of ``m`` stacked copies of the mesh, its gather, scatter index and fixed values."""
+        if m not in self._cache:
+            n = self._asm.n_free
+            geom = self.element.prepare(np.tile(self._q_ref_elements, (m, 1)), np.tile(self._lengths, m))
+            idx = (np.arange(m)[:, None] * (n + 1) + self._asm._vec_all[None, :]).ravel()
+            gather = (self._gather[None] * m + np.arange(m)[:, None, None]).reshape(-1, self._gather.shape[1])
+            self._cache[m] = (geom, gather, idx, np.repeat(self._q_fixed, m))
+        return self._cache[m]
+
+    def residuals(self, Q: np.ndarray, A: np.ndarray, F_ext: np.ndarray, load_factor: float) -> np.ndarray:
+        """``R[:, i] = f(Q[:, i]) + M A[:, i] - load_factor F_ext[:, i]``, shape (n_dof, m)."""
+        n, m = Q.shape
+        geom, gather, idx, q_fixed_m = self._stacked(m)
+        fused = self.element.fused_kernel(geom)
         if fused is None:
             ext = np.empty((n + self._q_fixed.size, m))   # (free q; fixed values) per stage, stage fastest
             ext[:n] = Q
@@ -50,42 +76,14 @@ class BeamStages:
             fe, _ = self.element.internal_forces(geom, ext.ravel().take(gather), False)
             F = np.bincount(idx, weights=fe.ravel(), minlength=m * (n + 1))
             F = F.reshape(m, n + 1)[:, :n].T
-            R = F + self._M_csr @ A
-            if not self._dead and not self._moments:
-                R -= self.load_factor * self._f_gravity[:, None]
-            else:
-                for i in range(m):
-                    R[:, i] -= self.load_factor * self._f_external(ts[i], Q[:, i], False)[0]
+            R = F + self._mass_csr @ A
+            R -= load_factor * F_ext
             return R
         fn, args = fused
         F = np.empty((m, n + 1))
-        q_fixed_m, gravity_m = self._stage_constants(m)
-        fn(np.ascontiguousarray(Q, dtype=float).reshape(-1), q_fixed_m, gather, idx,
-           self._asm._slot_all, False, F.reshape(-1), self._no_k, *args)
-        if not self._dead and not self._moments:
-            fext = gravity_m
-        else:
-            fext = np.column_stack([self._f_external(ts[i], Q[:, i], False)[0] for i in range(m)])
+        fn(np.ascontiguousarray(Q, dtype=float).reshape(-1), q_fixed_m, gather, idx, self._asm._slot_all, False,
+           F.reshape(-1), self._no_k, *args)
         R = np.empty((n, m))
-        _finish_stages()(F, self._M_data, self._asm.indptr, self._asm.indices, np.ascontiguousarray(A, dtype=float),
-                         float(self.load_factor), fext, R)
+        _finish_stages()(F, self._mass_data, self._asm.indptr, self._asm.indices, np.ascontiguousarray(A, dtype=float),
+                         float(load_factor), F_ext, R)
         return R
-
-    def _stage_constants(self, m):
-        """The fixed coordinates repeated per stage and the gravity force per stage, (n, m) (cached)."""
-        cache = self.__dict__.setdefault("_stage_const", {})
-        if m not in cache:
-            cache[m] = (np.repeat(self._q_fixed, m), np.repeat(self._f_gravity[:, None], m, axis=1))
-        return cache[m]
-
-    def _stage_geometry(self, m):
-        """Element geometry of ``m`` stacked copies of the mesh and the matching scatter index."""
-        cache = self.__dict__.setdefault("_stage_cache", {})
-        if m not in cache:
-            q_ref_e = self.q_ref[self.edofs]
-            geom = self.element.prepare(np.tile(q_ref_e, (m, 1)), np.tile(self.lengths, m))
-            vec_all = self._asm._vec_all
-            idx = (np.arange(m)[:, None] * (self.n_dof + 1) + vec_all[None, :]).ravel()
-            gather = (self._gather[None] * m + np.arange(m)[:, None, None]).reshape(-1, self._gather.shape[1])
-            cache[m] = (geom, gather, idx)
-        return cache[m]

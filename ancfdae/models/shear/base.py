@@ -2,23 +2,25 @@
 
 The two elements differ only in their dimension, their frame (chapter Eq. 7 or
 its planar analogue) and their moment load; the mesh handling, the quadrature
-options, the mass matrix and both strain-energy formulations live here.
+options, the mass matrix and the preparation of both strain-energy
+formulations live here, the kernels in :mod:`.kernels` (NumPy) and
+:mod:`.kernels_numba` (compiled).
 """
 from __future__ import annotations
 
 import numbers
 
-from typing import Callable
-
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._quadrature import gauss
 from ..._validate import choice
 from ...materials import CircularSection, Material, RectangularSection
-from ..element import Element
-from ..._quadrature import gauss
-from .._kernel_option import KernelOption
-from .kernels import assemble, continuum_kernel, local_map, rule, shapes, structural_kernel, voigt
+from ..element import Element, Kernel
+from .continuum import voigt
+from .kernels import SQReference
+from .points import local_map, rule, shapes
+from .structural import structural_kernel
 
 __all__ = ["SQElement", "shear_factors"]
 
@@ -34,10 +36,17 @@ def shear_factors(section, material) -> tuple[float, float]:
     return k, k
 
 
-class SQElement(KernelOption, Element):
+def _compiled(element: SQElement) -> Kernel:
+    """The compiled kernel object; its module, and numba's loops with it, is imported when selected."""
+    from .kernels_numba import SQCompiled
+    return SQCompiled(element)
+
+
+class SQElement(Element):
     """Shared implementation; see :class:`~ancfdae.models.SQ2D` and :class:`~ancfdae.models.SQ3D`."""
 
     formulations = ("structural", "continuum", "continuum-locking")
+    kernel_twins = {"numpy": SQReference, "numba": _compiled}
     node_params = (-1.0, 1.0, 0.0)    # class default (quadratic); instances set their own
     #: term of each structural strain component, in the order returned by ``_strains``
     _terms: tuple[str, ...] = ()
@@ -260,70 +269,15 @@ class SQElement(KernelOption, Element):
         return M.reshape(len(lengths), n, n)
 
     # -- kernels ----------------------------------------------------------------------------
-    def _evaluate(self, geom, q, order):
-        """Per point group: energy (n_el,), force and tangent (or None) of the elements."""
-        q = np.asarray(q, dtype=float)
-        W, f, K = 0.0, 0.0, None
-        for grp in geom["groups"]:
-            B = grp["B"]
-            E, P, nv = B.shape[:3]
-            v = np.einsum("epvi,ei->epv", B, q).reshape(E * P, nv)
-            if self.formulation == "structural":
-                w, g, H, _ = structural_kernel(self._strains, grp["which"], v, self.dim, grp["ref"], grp["Dw"],
-                                               order)
-            else:
-                w, g, H = continuum_kernel(v, self.dim, grp["Pc"], grp["ws"], grp["Ds"], grp["ref"], grp["wax"],
-                                           order)
-            W = W + w.reshape(E, P).sum(axis=1)
-            if order >= 1:
-                fg, Kg = assemble(B, g.reshape(E, P, nv), None if H is None else H.reshape(E, P, nv, nv))
-                f = f + fg
-                K = Kg if K is None else K + Kg
-        return W, f, K
-
-    def _evaluate_numba(self, geom, q, order):
-        """The compiled kernel (:mod:`ancfdae.models._sq_numba`); its arrays are built once per geometry."""
-        from . import kernels_numba as _sq_numba
-        nbg = geom.get("_numba")
-        if nbg is None:
-            nbg = geom["_numba"] = _numba_geometry(self.formulation, self.dim, self._stiffness_count(), geom)
-        q = np.ascontiguousarray(q, dtype=float)
-        if self.formulation == "structural":
-            return _sq_numba.sq_structural(q, *nbg, self.dim, order)
-        return _sq_numba.sq_continuum(q, *nbg, self.dim, order)
-
-    def fused_kernel(self, geom: dict) -> tuple[Callable, tuple] | None:
-        """The fused compiled entry point ``(fn, args)`` with the compiled kernel selected, else None."""
-        if self._impl != "numba":
-            return None
-        hit = geom.get("_numba_fused")
-        if hit is None:
-            from . import fused_numba as fz
-            nbg = geom.get("_numba")
-            if nbg is None:
-                nbg = geom["_numba"] = _numba_geometry(self.formulation, self.dim, self._stiffness_count(), geom)
-            fn = fz.sq_structural_fused if self.formulation == "structural" else fz.sq_continuum_fused
-            hit = geom["_numba_fused"] = (fn, tuple(nbg) + (self.dim,))
-        return hit
-
-    def _stiffness_count(self) -> int:
-        return len(self._terms)
-
     def mass_matrix(self, geom: dict) -> np.ndarray:
         return geom["M"]
 
     def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
-        if self._impl == "numba":
-            return self._evaluate_numba(geom, q, 0)[0]
-        return self._evaluate(geom, q, 0)[0]
+        return self.kernels.strain_energy(geom, q)
 
     def internal_forces(self, geom: dict, q: np.ndarray,
                         tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        if self._impl == "numba":
-            _, f, K = self._evaluate_numba(geom, q, 2 if tangent else 1)
-            return f, (K if tangent else None)
-        _, f, K = self._evaluate(geom, q, 2 if tangent else 1)
-        return f, K
+        return self.kernels.internal_forces(geom, q, tangent)
 
     def shape_matrix(self, s: ArrayLike, lengths: ArrayLike) -> np.ndarray:
         N, _ = shapes(self.nodes, np.asarray(s, dtype=float), np.asarray(lengths, dtype=float))
@@ -333,61 +287,6 @@ class SQElement(KernelOption, Element):
             S[:, :, c, :, 0, c] = N
         return S.reshape(E, P, self.dim, -1)
 
-    def _slope_map(self, geom, s, element):
-        """``p = Bp q_e``: the cross-section slopes at ``s`` of one element, shape (n_p, n_edof)."""
-        N, dN = shapes(self.nodes, np.array([float(s)]), geom["L"][[element]])
-        return local_map(N, dN, self.dim)[0, 0, :self.dim * (self.dim - 1)]
-
     def moment_load(self, geom: dict, q: np.ndarray, s: float, moment: np.ndarray, element: int,
                     tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        if self._impl == "numba":
-            from .moment_numba import sq_moment_load
-            f, K = sq_moment_load(np.ascontiguousarray(q, dtype=float), float(s), self.nodes, self.dim,
-                                  np.ascontiguousarray(moment, dtype=float), bool(tangent))
-            return f, (K if tangent else None)
-        Bp = self._slope_map(geom, s, element)
-        fp, dfp = self._rotation_force(Bp @ np.asarray(q, dtype=float), np.asarray(moment, dtype=float))
-        return Bp.T @ fp, (Bp.T @ dfp @ Bp if tangent else None)
-
-
-def _numba_geometry(formulation, dim, n_strain, geom):
-    """Contiguous arrays for the compiled kernels, from the NumPy kernel's point groups.
-
-    Structural: every group's points concatenated per element, with the stiffness and the
-    reference strains widened to all strain components (zero where a group's terms do not act).
-    Continuum: the section map ``Pc`` as the sparse table the compiled kernel walks.
-    """
-    groups = geom["groups"]
-    n_el = groups[0]["N"].shape[0]
-    N = np.ascontiguousarray(np.concatenate([g["N"] for g in groups], axis=1))
-    dN = np.ascontiguousarray(np.concatenate([g["dN"] for g in groups], axis=1))
-    if formulation == "structural":
-        Dw, ref = [], []
-        for g in groups:
-            P = g["N"].shape[1]
-            full_D, full_r = np.zeros((n_el, P, n_strain)), np.zeros((n_el, P, n_strain))
-            full_D[:, :, g["which"]] = g["Dw"].reshape(n_el, P, -1)
-            full_r[:, :, g["which"]] = g["ref"].reshape(n_el, P, -1)
-            Dw.append(full_D)
-            ref.append(full_r)
-        return (N, dN, np.ascontiguousarray(np.concatenate(Dw, axis=1)),
-                np.ascontiguousarray(np.concatenate(ref, axis=1)))
-    (g,) = groups
-    Pc = g["Pc"]
-    S, _, nb = Pc.shape
-    used = [[b for b in range(nb) if np.any(Pc[:, c, b] != 0.0)] for c in range(dim)]
-    width = max(len(u) for u in used)
-    blk = np.zeros((S, dim, width), dtype=np.int64)
-    coef = np.zeros((S, dim, width))
-    cnt = np.zeros((S, dim), dtype=np.int64)
-    for c, u in enumerate(used):
-        blk[:, c, :len(u)] = u
-        coef[:, c, :len(u)] = Pc[:, c, u]
-        cnt[:, c] = len(u)
-    pairs, _ = voigt(dim)
-    vi = np.array([p[0] for p in pairs], dtype=np.int64)
-    vj = np.array([p[1] for p in pairs], dtype=np.int64)
-    P = g["N"].shape[1]
-    return (N, dN, np.ascontiguousarray(g["wax"].reshape(n_el, P)), blk, coef, cnt,
-            np.ascontiguousarray(g["ws"], dtype=float), np.ascontiguousarray(g["Ds"], dtype=float),
-            np.ascontiguousarray(g["ref"].reshape(n_el, P, S, -1)), vi, vj)
+        return self.kernels.moment_load(geom, q, s, moment, element, tangent)

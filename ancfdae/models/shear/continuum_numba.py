@@ -1,13 +1,13 @@
 """Compiled continuum-mechanics energy density of SQ2D and SQ3D at one axial point.
 
-The same energy as :func:`ancfdae.models._sq_kernels.continuum_kernel`:
+The same energy as :func:`.continuum.continuum_kernel`:
 St. Venant-Kirchhoff on the Green strain (chapter Eqs. 13, 28-33) integrated
 over the cross-section by points. At section point ``s`` the convected
 gradient has the columns ``X_c = sum_b P[s, c, b] v_b`` (``x_xi = r' + eta
 a_2' (+ zeta a_3')``, ``x_eta = a_2`` (, ``x_zeta = a_3``)); each column
 uses only a few blocks ``b`` of the local variables, given as the sparse
 table ``blk[s, c, m]``, ``coef[s, c, m]`` with ``cnt[s, c]`` entries. The
-Voigt order is that of :func:`ancfdae.models._sq_kernels.voigt` (pairs
+Voigt order is that of :func:`.continuum.voigt` (pairs
 ``vi[a], vj[a]``): normal strains ``C_ii / 2``, engineering shears ``C_ij``.
 """
 from __future__ import annotations

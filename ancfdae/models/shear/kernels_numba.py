@@ -1,35 +1,45 @@
 """Compiled SQ2D/SQ3D kernels: energy, internal forces and exact tangent of all elements in one call.
 
-The compiled counterpart of :meth:`SQElement._evaluate` (NumPy reference in
-:mod:`ancfdae.models._sq_kernels`). Each entry point loops over the elements
+The compiled twin of :class:`.kernels.SQReference`, as the kernel object
+:class:`SQCompiled`. Each entry point loops over the elements
 and calls an inlined per-element function that loops over the element's
 quadrature points: it gathers the local variables ``v = B q_e`` (chapter
 Eqs. 104-107: ``a_k`` with the shape functions, ``r', a_k'`` with their
 derivatives), evaluates the energy density's gradient ``g`` and Hessian
-``H`` (:mod:`ancfdae.models._sq_numba_structural`,
-:mod:`ancfdae.models._sq_numba_continuum`) and scatters ``B^T g`` and
+``H`` (:mod:`.structural_numba`, :mod:`.continuum_numba`) and scatters ``B^T g`` and
 ``B^T H B`` into the element's output rows without forming ``B``. Work arrays
 are allocated once per call, never per point.
 
-Importing this module imports numba; :mod:`ancfdae.models._sq_common` does so
+The fused entry points :func:`sq_structural_fused` and :func:`sq_continuum_fused`
+add the gather of the element coordinates and the scatter into the beam's CSR
+data (:mod:`ancfdae.models.beam.assembly_numba`) around the same loops.
+
+Importing this module compiles (or loads) numba code; :mod:`.base` imports it
 only when the compiled kernel is selected.
 
 numba's on-disk cache is keyed on the source file of the cached function
-only: after editing a function it calls from another file
-(:mod:`~ancfdae.models._vector_jet_numba`, :mod:`~ancfdae.models._sq_numba_structural`,
-:mod:`~ancfdae.models._sq_numba_continuum`), delete the ``*.nbi``/``*.nbc``
-files in ``ancfdae/models/__pycache__``, or the old code keeps running (the
-same holds for :mod:`~ancfdae.models._sq_numba_moment`).
+only, and a cached function holds a compiled copy of the functions it calls:
+after editing a function in another file (:mod:`ancfdae.models.jets.vector_numba`,
+:mod:`.structural_numba`, :mod:`.continuum_numba`), delete the
+``*.nbi``/``*.nbc`` files in the ``__pycache__`` folders, or the old code keeps
+running (measured: a stale cache kept running the previous SQ tangent, which
+``tests/test_fused_assembly.py`` caught as a fused/NumPy-assembly mismatch;
+the same holds for :mod:`.moment_numba`).
 """
 from __future__ import annotations
 
 import numpy as np
 from numba import njit
 
+from ..beam.assembly_numba import gather_elements, scatter
+from ..element import Kernel
+from .continuum import voigt
 from .continuum_numba import continuum_point
+from .moment_numba import sq_moment_load
 from .structural_numba import N_JETS, needs_frame, structural_point
 
-__all__ = ["sq_structural", "sq_continuum"]
+__all__ = ["SQCompiled", "compiled_geometry", "sq_structural", "sq_continuum", "sq_structural_fused",
+           "sq_continuum_fused"]
 
 _INLINE = dict(cache=True, inline="always", fastmath={"contract"})
 
@@ -202,3 +212,115 @@ def sq_continuum(q, N, dN, wax, blk, coef, cnt, ws, Ds, ref, vi, vj, dim, order)
                                       f[e], K[e if order >= 2 else 0], order, Sb, col, v, g, H, X, eps, sig, S,
                                       Bm, DB, HX)
     return W, f, K[:n_el if order >= 2 else 0]
+
+
+@njit(cache=True)
+def sq_structural_fused(q, q_fixed, gather, vec_slot, mat_slot, tangent, r, kdata, N, dN, Dw, ref, dim):
+    """Structural formulation: ``dU/dq`` into ``r`` and, if ``tangent``, its tangent into ``kdata``."""
+    qe = gather_elements(q, q_fixed, gather)
+    _, f, K = sq_structural(qe, N, dN, Dw, ref, dim, 2 if tangent else 1)
+    scatter(f, vec_slot, r)
+    if tangent:
+        scatter(K, mat_slot, kdata)
+
+
+@njit(cache=True)
+def sq_continuum_fused(q, q_fixed, gather, vec_slot, mat_slot, tangent, r, kdata,
+                       N, dN, wax, blk, coef, cnt, ws, Ds, ref, vi, vj, dim):
+    """Continuum formulation: as :func:`sq_structural_fused`."""
+    qe = gather_elements(q, q_fixed, gather)
+    _, f, K = sq_continuum(qe, N, dN, wax, blk, coef, cnt, ws, Ds, ref, vi, vj, dim, 2 if tangent else 1)
+    scatter(f, vec_slot, r)
+    if tangent:
+        scatter(K, mat_slot, kdata)
+
+
+class SQCompiled(Kernel):
+    """The compiled kernel object of SQ2D and SQ3D: :func:`sq_structural` or :func:`sq_continuum`, the
+    compiled dead moment and the fused entry points."""
+
+    name = "numba"
+
+    def _arrays(self, geom):
+        """The compiled kernels' arrays of ``geom`` (:func:`compiled_geometry`), built once per geometry."""
+        arrays = geom.get("_numba")
+        if arrays is None:
+            el = self.element
+            arrays = geom["_numba"] = compiled_geometry(el.formulation, el.dim, len(el._terms), geom)
+        return arrays
+
+    def evaluate(self, geom: dict, q: np.ndarray, order: int) -> tuple:
+        """As :meth:`.kernels.SQReference.evaluate`, compiled (the forces are zeros for ``order`` 0)."""
+        q = np.ascontiguousarray(q, dtype=float)
+        if self.element.formulation == "structural":
+            return sq_structural(q, *self._arrays(geom), self.element.dim, order)
+        return sq_continuum(q, *self._arrays(geom), self.element.dim, order)
+
+    def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
+        """Strain energy per element."""
+        return self.evaluate(geom, q, 0)[0]
+
+    def internal_forces(self, geom: dict, q: np.ndarray,
+                        tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """``f = dU/dq_e`` and, if ``tangent``, ``K = df/dq_e``."""
+        _, f, K = self.evaluate(geom, q, 2 if tangent else 1)
+        return f, (K if tangent else None)
+
+    def moment_load(self, geom: dict, q: np.ndarray, s: float, moment: np.ndarray, element: int,
+                    tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """As :meth:`.kernels.SQReference.moment_load`, compiled."""
+        el = self.element
+        f, K = sq_moment_load(np.ascontiguousarray(q, dtype=float), float(s), el.nodes, el.dim,
+                              np.ascontiguousarray(moment, dtype=float), bool(tangent))
+        return f, (K if tangent else None)
+
+    def fused(self, geom: dict) -> tuple:
+        """``(sq_structural_fused or sq_continuum_fused, args)`` (see :meth:`ancfdae.models.Element.fused_kernel`)."""
+        hit = geom.get("_numba_fused")
+        if hit is None:
+            fn = sq_structural_fused if self.element.formulation == "structural" else sq_continuum_fused
+            hit = geom["_numba_fused"] = (fn, tuple(self._arrays(geom)) + (self.element.dim,))
+        return hit
+
+
+def compiled_geometry(formulation: str, dim: int, n_strain: int, geom: dict) -> tuple:
+    """Contiguous arrays for the compiled kernels, from the NumPy kernel's point groups.
+
+    Structural: every group's points concatenated per element, with the stiffness and the
+    reference strains widened to all strain components (zero where a group's terms do not act).
+    Continuum: the section map ``Pc`` as the sparse table the compiled kernel walks.
+    """
+    groups = geom["groups"]
+    n_el = groups[0]["N"].shape[0]
+    N = np.ascontiguousarray(np.concatenate([g["N"] for g in groups], axis=1))
+    dN = np.ascontiguousarray(np.concatenate([g["dN"] for g in groups], axis=1))
+    if formulation == "structural":
+        Dw, ref = [], []
+        for g in groups:
+            P = g["N"].shape[1]
+            full_D, full_r = np.zeros((n_el, P, n_strain)), np.zeros((n_el, P, n_strain))
+            full_D[:, :, g["which"]] = g["Dw"].reshape(n_el, P, -1)
+            full_r[:, :, g["which"]] = g["ref"].reshape(n_el, P, -1)
+            Dw.append(full_D)
+            ref.append(full_r)
+        return (N, dN, np.ascontiguousarray(np.concatenate(Dw, axis=1)),
+                np.ascontiguousarray(np.concatenate(ref, axis=1)))
+    (g,) = groups
+    Pc = g["Pc"]
+    S, _, nb = Pc.shape
+    used = [[b for b in range(nb) if np.any(Pc[:, c, b] != 0.0)] for c in range(dim)]
+    width = max(len(u) for u in used)
+    blk = np.zeros((S, dim, width), dtype=np.int64)
+    coef = np.zeros((S, dim, width))
+    cnt = np.zeros((S, dim), dtype=np.int64)
+    for c, u in enumerate(used):
+        blk[:, c, :len(u)] = u
+        coef[:, c, :len(u)] = Pc[:, c, u]
+        cnt[:, c] = len(u)
+    pairs, _ = voigt(dim)
+    vi = np.array([p[0] for p in pairs], dtype=np.int64)
+    vj = np.array([p[1] for p in pairs], dtype=np.int64)
+    P = g["N"].shape[1]
+    return (N, dN, np.ascontiguousarray(g["wax"].reshape(n_el, P)), blk, coef, cnt,
+            np.ascontiguousarray(g["ws"], dtype=float), np.ascontiguousarray(g["Ds"], dtype=float),
+            np.ascontiguousarray(g["ref"].reshape(n_el, P, S, -1)), vi, vj)

@@ -45,15 +45,16 @@ class SQ2D(SQElement):
         ``"shear"``, ``"bending"``, ``"cross_section"``; continuum ``"axial"``,
         ``"section"``; each a number of Gauss points or
         ``("gauss"|"lobatto", n)``.
-    kernel : {"auto", "numpy", "numba"}
-        Implementation of the energy, forces and tangent. ``"numpy"``: the
-        vectorised NumPy kernels of :mod:`ancfdae.models._sq_kernels`, the
-        readable reference. ``"numba"``: one compiled loop over elements x
-        points (:mod:`ancfdae.models._sq_numba`, same results to rounding; the
-        first use compiles, 1-3 minutes on a loaded 2-core machine, then
-        loads from the on-disk cache in about a second). ``"auto"`` (default):
-        numba when importable, else NumPy. Settable later through the
-        ``kernel`` attribute; ``kernel_in_use`` says which one runs.
+    kernel : {"auto", "numba", "numpy"}
+        Implementation of the energy, forces, tangent and moment load.
+        ``"numba"`` and ``"auto"`` (the default): one compiled loop over
+        elements x points (:class:`~ancfdae.models.shear.kernels_numba.SQCompiled`,
+        same results to rounding; the first use compiles, 1-3 minutes on a
+        loaded 2-core machine, then loads from the on-disk cache in about a
+        second). ``"numpy"``: the vectorised NumPy kernels
+        (:class:`~ancfdae.models.shear.kernels.SQReference`), the readable
+        reference. Settable later through the ``kernel`` attribute;
+        ``kernel_in_use`` says which one runs.
     """
 
     name = "SQ2D"

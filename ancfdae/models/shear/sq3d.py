@@ -70,7 +70,7 @@ class SQ3D(SQElement):
         Quadratic (default, Eq. 107) or linear (Eq. 106) interpolation.
     quadrature : dict, optional
         As for :class:`~ancfdae.models.SQ2D`.
-    kernel : {"auto", "numpy", "numba"}
+    kernel : {"auto", "numba", "numpy"}
         As for :class:`~ancfdae.models.SQ2D`: the compiled kernel (default)
         or the NumPy reference.
     """

@@ -1,12 +1,12 @@
 """Compiled structural-mechanics energy density of SQ2D and SQ3D at one quadrature point.
 
-The same energy as :func:`ancfdae.models._sq_kernels.structural_kernel` with
+The same energy as :func:`.structural.structural_kernel` with
 the strains of :meth:`SQ2D._strains` and :meth:`SQ3D._strains` (chapter
 Eqs. 7, 16, 19, 25, 45, 50): ``W = 1/2 sum_k Dw_k (eps_k - ref_k)^2`` with
 every strain linear in the derivative variables ``d = (r', a_k')`` and
 nonlinear in the slopes ``p = (a_k)`` only, ``eps_k = sum_j c_kj(p) . d_j +
 f_k s_k(p)``. The coefficient vectors ``c_kj`` and the quadratic terms
-``s_k`` are jets over ``p`` (:mod:`ancfdae.models._vector_jet_numba`), so the
+``s_k`` are jets over ``p`` (:mod:`ancfdae.models.jets.vector_numba`), so the
 gradient and the Hessian of ``W`` in the local variables ``v = (p, d)`` are
 exact. Jets are rows of the work arrays ``JV``, ``JG``, ``JH``; the tables
 below say which row holds which quantity.

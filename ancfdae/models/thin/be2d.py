@@ -14,17 +14,16 @@ exact, for all elements and points in a few ``einsum`` calls.
 """
 from __future__ import annotations
 
-from typing import Callable
-
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._quadrature import gauss
 from ..._validate import choice, positive_int
 from ...materials import CircularSection, Material, RectangularSection
-from ..element import Element
-from .._kernel_option import KernelOption
-from ..._quadrature import gauss
+from ..element import Element, Kernel
 from ..shapes import hermite
+
+__all__ = ["BE2D", "BE2DReference", "invariants", "densities"]
 
 __all__ = ["BE2D"]
 
@@ -40,7 +39,125 @@ def _expand2(N: np.ndarray) -> np.ndarray:
     return out
 
 
-class BE2D(KernelOption, Element):
+
+def invariants(geom: dict, q: np.ndarray, order: int = 1) -> tuple:
+    """``g = r'.r'`` and ``c = (r' x r'').e_z`` at every point, shape (n_el, n_pts); for ``order`` 1 also
+    their gradients ``dg``, ``dc`` in the element coordinates, shape (4, 2, n_el, n_pts)."""
+    Q = q.reshape(q.shape[0], 4, 2)
+    r1 = np.ascontiguousarray((geom["dN_e"] @ Q).transpose(2, 0, 1))      # (2, n_el, n_pts)
+    r2 = np.ascontiguousarray((geom["ddN_e"] @ Q).transpose(2, 0, 1))
+    g = r1[0] * r1[0] + r1[1] * r1[1]
+    c = r1[0] * r2[1] - r1[1] * r2[0]
+    if order == 0:
+        return g, c
+    dN, ddN = geom["dN"], geom["ddN"]
+    dg = dN * (2.0 * r1)
+    # dc = Sx^T P r'' + Sxx^T P^T r', with P r'' = (r''_y, -r''_x), P^T r' = (-r'_y, r'_x)
+    r2[0] *= -1.0
+    r1[1] *= -1.0
+    dc = dN * r2[::-1] + ddN * r1[::-1]
+    return g, c, dg, dc
+
+
+def densities(element: BE2D, g: np.ndarray, c: np.ndarray, geom: dict, order: int = 2) -> list:
+    """The energy density of Eqs. 82-88 and its derivatives in (g, c), each of shape (n_el, n_pts):
+    ``(W, Wg, Wc)``, and for ``order`` 2 also ``(Wgg, Wgc, Wcc)``.
+
+    Axial terms act at the axial rule's points (the first ``n_a``), bending
+    terms at the bending rule's points; each is evaluated on its own slice.
+    """
+    E, sec = element.material.E, element.section
+    EA, EI = E * sec.A, E * sec.I3
+    na = geom["n_a"]
+    ga, gb, cb = g[:, :na], g[:, na:], c[:, na:]
+    out = [np.empty_like(g) for _ in range(6 if order >= 2 else 3)]
+    if element.formulation == "structural":
+        a = 1.0 + geom["eps_ref"][:, :na]
+        rg = np.sqrt(ga)
+        Kr = geom["K_ref"][:, na:]
+        igb = 1.0 / gb
+        K = cb * igb
+        dK = K - Kr
+        out[0][:, :na] = 0.5 * EA * (rg - a) ** 2
+        out[0][:, na:] = 0.5 * EI * dK * dK
+        out[1][:, :na] = EA * (0.5 - 0.5 * a / rg)
+        out[1][:, na:] = -EI * dK * K * igb
+        out[2][:, :na] = 0.0
+        out[2][:, na:] = EI * dK * igb
+        if order >= 2:
+            igb2 = igb * igb
+            out[3][:, :na] = 0.25 * EA * a / (ga * rg)
+            out[3][:, na:] = EI * (3 * K - 2 * Kr) * K * igb2
+            out[4][:, :na] = 0.0
+            out[4][:, na:] = -EI * (2 * K - Kr) * igb2
+            out[5][:, :na] = 0.0
+            out[5][:, na:] = EI * igb2
+        return out
+    a = 0.5 * (ga - 1.0)
+    I, I4 = sec.I3, sec.I4
+    ig = 1.0 / gb
+    phi = (1.5 - 0.5 * ig) * ig
+    phi1 = (-1.5 + ig) * ig**2
+    psi, psi1 = 0.25 * ig**4, -ig**5
+    c2 = cb * cb
+    out[0][:, :na] = 0.5 * EA * a**2
+    out[0][:, na:] = 0.5 * E * (I * c2 * phi + I4 * c2 * c2 * psi)
+    out[1][:, :na] = 0.5 * EA * a
+    out[1][:, na:] = 0.5 * E * (I * c2 * phi1 + I4 * c2 * c2 * psi1)
+    out[2][:, :na] = 0.0
+    out[2][:, na:] = E * (I * cb * phi + 2 * I4 * c2 * cb * psi)
+    if order >= 2:
+        phi2 = (3.0 - 3.0 * ig) * ig**3
+        psi2 = 5.0 * ig**6
+        out[3][:, :na] = 0.25 * EA
+        out[3][:, na:] = 0.5 * E * (I * c2 * phi2 + I4 * c2 * c2 * psi2)
+        out[4][:, :na] = 0.0
+        out[4][:, na:] = E * (I * cb * phi1 + 2 * I4 * c2 * cb * psi1)
+        out[5][:, :na] = 0.0
+        out[5][:, na:] = E * (I * phi + 6 * I4 * c2 * psi)
+    return out
+
+
+class BE2DReference(Kernel):
+    """The NumPy reference of BE2D's internal forces and tangent, a few ``einsum`` calls over all elements x points.
+
+    The force is ``W_g dg + W_c dc`` and the tangent
+    ``W_gg dg dg^T + W_gc (dg dc^T + dc dg^T) + W_cc dc dc^T + W_g d2g + W_c d2c``
+    (module docstring); the compiled twin is :class:`~.be2d_numba.BE2DCompiled`.
+    """
+
+    name = "numpy"
+
+    def internal_forces(self, geom: dict, q: np.ndarray,
+                        tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """``f = dU/dq_e`` (n_el, 8) and, if ``tangent``, ``K = df/dq_e`` (n_el, 8, 8)."""
+        w = geom["w"]
+        g, c, dg, dc = invariants(geom, q)
+        W = densities(self.element, g, c, geom, 2 if tangent else 1)
+        n_el, n_pts = g.shape
+        # f_i = sum_p w (Wg dg_i + Wc dc_i)
+        wg, wc = w * W[1], w * W[2]
+        f = (np.sum(dg * wg + dc * wc, axis=-1)).reshape(8, n_el).T
+        if not tangent:
+            return f, None
+        Wgg, Wgc, Wcc = w * W[3], w * W[4], w * W[5]
+        Bg = dg * Wgg + dc * Wgc                         # H A, row g
+        Bc = dg * Wgc + dc * Wcc                         # H A, row c
+        A = np.concatenate([dg, dc], axis=-1).reshape(8, n_el, 2 * n_pts).transpose(1, 0, 2)
+        B = np.concatenate([Bg, Bc], axis=-1).reshape(8, n_el, 2 * n_pts).transpose(1, 2, 0)
+        first = np.stack([wg, wc], axis=1).reshape(n_el, 1, 2 * n_pts)
+        K = A @ B + (first @ geom["d2"]).reshape(n_el, 8, 8)
+        return f, K
+
+
+def _compiled(element: BE2D) -> Kernel:
+    """The compiled kernel object; its module, and numba's loops with it, is imported when selected."""
+    from .be2d_numba import BE2DCompiled
+    return BE2DCompiled(element)
+
+
+
+class BE2D(Element):
     """Planar Bernoulli-Euler ANCF beam element (chapter Sects. 3.1-3.3).
 
     Parameters
@@ -63,13 +180,13 @@ class BE2D(KernelOption, Element):
         Gauss points for the axial and the bending (curvature) terms. The
         defaults 5 and 3 (integration orders 9 and 5, as recommended at the
         end of Sect. 3.5) reproduce the chapter's Table 2.
-    kernel : {"auto", "numpy", "numba"}
-        Implementation of :meth:`internal_forces`. ``"numpy"``: vectorised
-        NumPy, the reference. ``"numba"``: one compiled loop over elements x
-        points (:mod:`ancfdae.models._be2d_numba`, same results to rounding;
-        the first call compiles, or loads the on-disk cache). ``"auto"``
-        (default): numba (a dependency of ancfdae) when importable, else
-        NumPy. Settable later through the ``kernel`` attribute.
+    kernel : {"auto", "numba", "numpy"}
+        Implementation of :meth:`internal_forces`. ``"numba"`` and ``"auto"``
+        (the default): one compiled loop over elements x points
+        (:class:`~.be2d_numba.BE2DCompiled`, same results to rounding; the
+        first call compiles, or loads the on-disk cache). ``"numpy"``:
+        vectorised NumPy (:class:`BE2DReference`), the reference. Settable
+        later through the ``kernel`` attribute.
     """
 
     name = "BE2D"
@@ -77,6 +194,7 @@ class BE2D(KernelOption, Element):
     node_params = (-1.0, 1.0)
     node_coordinates = ("x", "y", "x'", "y'")
     formulations = ("structural", "continuum")
+    kernel_twins = {"numpy": BE2DReference, "numba": _compiled}
 
     def __init__(self, material: Material, section: RectangularSection | CircularSection,
                  formulation: str = "structural", axial_points: int = 5, bending_points: int = 3,
@@ -136,7 +254,7 @@ class BE2D(KernelOption, Element):
         d2c = np.einsum("epk,epl,ab->epkalb", dN, ddN, _P) + np.einsum("epk,epl,ab->epkalb", ddN, dN, _P.T)
         geom["d2"] = np.stack([d2g.reshape(n_el, n_pts, 64), d2c.reshape(n_el, n_pts, 64)], axis=1
                               ).reshape(n_el, 2 * n_pts, 64)
-        g, c = self._invariants(geom, q_ref, derivatives=False)
+        g, c = invariants(geom, q_ref, order=0)
         geom["eps_ref"] = np.sqrt(g) - 1.0
         geom["K_ref"] = c / g
         if self.formulation == "continuum":
@@ -152,134 +270,16 @@ class BE2D(KernelOption, Element):
         return geom
 
     # -- kernels --------------------------------------------------------
-    @staticmethod
-    def _invariants(geom, q, derivatives=True):
-        """g, c at every point, shape (n_el, n_pts), and if asked dg, dc of shape (4, 2, n_el, n_pts)."""
-        Q = q.reshape(q.shape[0], 4, 2)
-        r1 = np.ascontiguousarray((geom["dN_e"] @ Q).transpose(2, 0, 1))      # (2, n_el, n_pts)
-        r2 = np.ascontiguousarray((geom["ddN_e"] @ Q).transpose(2, 0, 1))
-        g = r1[0] * r1[0] + r1[1] * r1[1]
-        c = r1[0] * r2[1] - r1[1] * r2[0]
-        if not derivatives:
-            return g, c
-        dN, ddN = geom["dN"], geom["ddN"]
-        dg = dN * (2.0 * r1)
-        # dc = Sx^T P r'' + Sxx^T P^T r', with P r'' = (r''_y, -r''_x), P^T r' = (-r'_y, r'_x)
-        r2[0] *= -1.0
-        r1[1] *= -1.0
-        dc = dN * r2[::-1] + ddN * r1[::-1]
-        return g, c, dg, dc
-
-    def _densities(self, g, c, geom, hessian=True):
-        """Energy density derivatives in (g, c): (W, Wg, Wc[, Wgg, Wgc, Wcc]), each (n_el, n_pts).
-
-        Axial terms act at the axial rule's points (the first ``n_a``), bending
-        terms at the bending rule's points; each is evaluated on its own slice.
-        """
-        E, sec = self.material.E, self.section
-        EA, EI = E * sec.A, E * sec.I3
-        na = geom["n_a"]
-        ga, gb, cb = g[:, :na], g[:, na:], c[:, na:]
-        out = [np.empty_like(g) for _ in range(6 if hessian else 3)]
-        if self.formulation == "structural":
-            a = 1.0 + geom["eps_ref"][:, :na]
-            rg = np.sqrt(ga)
-            Kr = geom["K_ref"][:, na:]
-            igb = 1.0 / gb
-            K = cb * igb
-            dK = K - Kr
-            out[0][:, :na] = 0.5 * EA * (rg - a) ** 2
-            out[0][:, na:] = 0.5 * EI * dK * dK
-            out[1][:, :na] = EA * (0.5 - 0.5 * a / rg)
-            out[1][:, na:] = -EI * dK * K * igb
-            out[2][:, :na] = 0.0
-            out[2][:, na:] = EI * dK * igb
-            if hessian:
-                igb2 = igb * igb
-                out[3][:, :na] = 0.25 * EA * a / (ga * rg)
-                out[3][:, na:] = EI * (3 * K - 2 * Kr) * K * igb2
-                out[4][:, :na] = 0.0
-                out[4][:, na:] = -EI * (2 * K - Kr) * igb2
-                out[5][:, :na] = 0.0
-                out[5][:, na:] = EI * igb2
-            return out
-        a = 0.5 * (ga - 1.0)
-        I, I4 = sec.I3, sec.I4
-        ig = 1.0 / gb
-        phi = (1.5 - 0.5 * ig) * ig
-        phi1 = (-1.5 + ig) * ig**2
-        psi, psi1 = 0.25 * ig**4, -ig**5
-        c2 = cb * cb
-        out[0][:, :na] = 0.5 * EA * a**2
-        out[0][:, na:] = 0.5 * E * (I * c2 * phi + I4 * c2 * c2 * psi)
-        out[1][:, :na] = 0.5 * EA * a
-        out[1][:, na:] = 0.5 * E * (I * c2 * phi1 + I4 * c2 * c2 * psi1)
-        out[2][:, :na] = 0.0
-        out[2][:, na:] = E * (I * cb * phi + 2 * I4 * c2 * cb * psi)
-        if hessian:
-            phi2 = (3.0 - 3.0 * ig) * ig**3
-            psi2 = 5.0 * ig**6
-            out[3][:, :na] = 0.25 * EA
-            out[3][:, na:] = 0.5 * E * (I * c2 * phi2 + I4 * c2 * c2 * psi2)
-            out[4][:, :na] = 0.0
-            out[4][:, na:] = E * (I * cb * phi1 + 2 * I4 * c2 * cb * psi1)
-            out[5][:, :na] = 0.0
-            out[5][:, na:] = E * (I * phi + 6 * I4 * c2 * psi)
-        return out
-
     def mass_matrix(self, geom: dict) -> np.ndarray:
         return geom["M"]
 
     def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
-        g, c = self._invariants(geom, q, derivatives=False)
-        return np.sum(geom["w"] * self._densities(g, c, geom, hessian=False)[0], axis=1)
+        g, c = invariants(geom, q, order=0)
+        return np.sum(geom["w"] * densities(self, g, c, geom, order=1)[0], axis=1)
 
     def internal_forces(self, geom: dict, q: np.ndarray,
                         tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        if self._impl == "numba":
-            return self._internal_forces_numba(geom, q, tangent)
-        w = geom["w"]
-        g, c, dg, dc = self._invariants(geom, q)
-        D = self._densities(g, c, geom, hessian=tangent)
-        n_el, n_pts = g.shape
-        # f_i = sum_p w (Wg dg_i + Wc dc_i)
-        wg, wc = w * D[1], w * D[2]
-        f = (np.sum(dg * wg + dc * wc, axis=-1)).reshape(8, n_el).T
-        if not tangent:
-            return f, None
-        Wgg, Wgc, Wcc = w * D[3], w * D[4], w * D[5]
-        Bg = dg * Wgg + dc * Wgc                         # H A, row g
-        Bc = dg * Wgc + dc * Wcc                         # H A, row c
-        A = np.concatenate([dg, dc], axis=-1).reshape(8, n_el, 2 * n_pts).transpose(1, 0, 2)
-        B = np.concatenate([Bg, Bc], axis=-1).reshape(8, n_el, 2 * n_pts).transpose(1, 2, 0)
-        first = np.stack([wg, wc], axis=1).reshape(n_el, 1, 2 * n_pts)
-        K = A @ B + (first @ geom["d2"]).reshape(n_el, 8, 8)
-        return f, K
-
-    def _numba_args(self, geom):
-        """The compiled module and the kernel's arguments after ``q`` (cached in the geometry)."""
-        hit = geom.get("_numba")
-        if hit is None:   # C-contiguous float copies for the compiled loop, once per geometry
-            from . import be2d_numba as nb   # imports numba: only once the compiled kernel is selected
-            form = nb.STRUCTURAL if self.formulation == "structural" else nb.CONTINUUM
-            E, sec = self.material.E, self.section
-            args = tuple(np.ascontiguousarray(geom[k], dtype=float)
-                         for k in ("dN_e", "ddN_e", "w", "eps_ref", "K_ref")) + (
-                geom["n_a"], form, E * sec.A, E, sec.I3, sec.I4)
-            hit = geom["_numba"] = (nb, args, (nb.be2d_fused, args))
-        return hit
-
-    def _internal_forces_numba(self, geom, q, tangent):
-        """The compiled kernel; imported (and numba with it) on first use."""
-        nb, args, _ = self._numba_args(geom)
-        f, K = nb.be2d_forces(np.ascontiguousarray(q, dtype=float), *args, bool(tangent))
-        return f, (K if tangent else None)
-
-    def fused_kernel(self, geom: dict) -> tuple[Callable, tuple] | None:
-        """``(be2d_fused, args)`` with the compiled kernel selected, else None (see :class:`Element`)."""
-        if self._impl != "numba":
-            return None
-        return self._numba_args(geom)[2]
+        return self.kernels.internal_forces(geom, q, tangent)
 
     def shape_matrix(self, s: ArrayLike, lengths: ArrayLike) -> np.ndarray:
         N, _, _ = hermite(np.asarray(s, dtype=float), lengths)

@@ -1,15 +1,15 @@
-"""Compiled BE2D kernel (the default of :class:`ancfdae.models.BE2D`, ``kernel="auto"``).
+"""Compiled BE2D kernel: the default of :class:`ancfdae.models.BE2D` (``kernel="auto"``).
 
-The same force and exact tangent as the NumPy kernel of :class:`ancfdae.models.BE2D`
+The same force and exact tangent as the NumPy reference :class:`.be2d.BE2DReference`
 (chapter Eqs. 70, 78, 82-88, written in the invariants ``g = r'.r'`` and
 ``c = (r' x r'').e_z``), computed in one compiled loop over elements x
-quadrature points. The loop is right here: it is compiled, and on small
-meshes it removes the per-call overhead of some fifty NumPy operations on
-arrays of a few hundred entries. The NumPy kernel stays the reference; the
-tests compare the two on random deformed states.
+quadrature points: on small meshes it removes the per-call overhead of some
+fifty NumPy operations on arrays of a few hundred entries. The tests compare
+the two on random deformed states. :class:`BE2DCompiled` is the kernel object;
+it also offers the fused assembly entry point :func:`be2d_fused`.
 
-Importing this module imports numba; :mod:`ancfdae.models.be2d` does so only
-when the compiled kernel is selected.
+Importing this module compiles (or loads) numba code; :mod:`.be2d` imports it
+only when the compiled kernel is selected.
 """
 from __future__ import annotations
 
@@ -17,8 +17,9 @@ import numpy as np
 from numba import njit
 
 from ..beam.assembly_numba import gather_elements, scatter
+from ..element import Kernel
 
-__all__ = ["be2d_forces", "be2d_fused", "STRUCTURAL", "CONTINUUM"]
+__all__ = ["BE2DCompiled", "be2d_forces", "be2d_fused", "STRUCTURAL", "CONTINUUM"]
 
 STRUCTURAL, CONTINUUM = 0, 1
 
@@ -146,7 +147,7 @@ def be2d_forces(q, dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4, tangent)
 @njit(cache=True)
 def be2d_fused(q, q_fixed, gather, vec_slot, mat_slot, tangent, r, kdata,
                dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4):
-    """Gather, kernel and scatter in one call (the fused assembly of ``_assembly_numba``).
+    """Gather, kernel and scatter in one call (the fused assembly of :mod:`ancfdae.models.beam.assembly_numba`).
 
     ``r`` (length ``n_dof + 1``) receives the assembled ``dU/dq`` and, if
     ``tangent``, ``kdata`` (length ``nnz + 1``) the CSR data of its tangent;
@@ -157,3 +158,31 @@ def be2d_fused(q, q_fixed, gather, vec_slot, mat_slot, tangent, r, kdata,
     scatter(f, vec_slot, r)
     if tangent:
         scatter(K, mat_slot, kdata)
+
+
+class BE2DCompiled(Kernel):
+    """The compiled kernel object of BE2D: :func:`be2d_forces` and the fused entry point :func:`be2d_fused`."""
+
+    name = "numba"
+
+    def _args(self, geom):
+        """The kernel's arguments after ``q``: C-contiguous float copies, made once per geometry."""
+        args = geom.get("_numba")
+        if args is None:
+            el = self.element
+            E, sec = el.material.E, el.section
+            form = STRUCTURAL if el.formulation == "structural" else CONTINUUM
+            args = geom["_numba"] = tuple(np.ascontiguousarray(geom[k], dtype=float)
+                                          for k in ("dN_e", "ddN_e", "w", "eps_ref", "K_ref")) + (
+                geom["n_a"], form, E * sec.A, E, sec.I3, sec.I4)
+        return args
+
+    def internal_forces(self, geom: dict, q: np.ndarray,
+                        tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """As :meth:`.be2d.BE2DReference.internal_forces`, compiled."""
+        f, K = be2d_forces(np.ascontiguousarray(q, dtype=float), *self._args(geom), bool(tangent))
+        return f, (K if tangent else None)
+
+    def fused(self, geom: dict) -> tuple:
+        """``(be2d_fused, args)``: the fused assembly entry point (see :meth:`ancfdae.models.Element.fused_kernel`)."""
+        return be2d_fused, self._args(geom)

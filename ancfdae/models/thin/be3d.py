@@ -2,9 +2,11 @@
 
 Two nodes with coordinates ``(x, y, z, x', y', z', theta)`` -- position, axial
 slope and torsion angle -- 14 DOF per element: the cubic Hermite axis of
-Eq. 62 and the linear angle of Eqs. 101-103. Kinematics in
-:mod:`._be3d_kinematics`, inertia and director update in
-:mod:`._be3d_dynamics`.
+Eq. 62 and the linear angle of Eqs. 101-103. This module holds the element and
+the NumPy reference of its strain energy (:class:`BE3DReference`); kinematics
+in :mod:`.be3d_kinematics`, rotary inertia in :mod:`.be3d_inertia`, the dead
+moment in :mod:`.be3d_moment`, the directors in :mod:`.be3d_directors`, and
+the compiled twins beside them (``*_numba.py``).
 """
 from __future__ import annotations
 
@@ -13,28 +15,79 @@ from numpy.typing import ArrayLike
 
 from ..._validate import choice, finite_vector, positive_int
 from ...materials import CircularSection, Material, RectangularSection
-from .be3d_inertia import UPDATES, rotary_inertia, rotary_kinetic_energy
-from .be3d_directors import BE3DEvents
-from .be3d_kinematics import curvature_energy, curvatures, director_field, frames, spin_gradient
-from ..element import Element
-from .._kernel_option import KernelOption
-from ..jets import scalar as jet
-from ..jets.scalar import Jet
-from ..shapes import hermite, linear
+from ..element import Element, Kernel
+from ..shapes import hermite
+from . import be3d_directors as directors_
+from .be3d_inertia import rotary_inertia, rotary_kinetic_energy
+from .be3d_kinematics import (DOF, N_EDOF, TorsionRule, curvature_energy, curvatures, director_field, frames,
+                              local_variables, spin_gradient)
+from .be3d_moment import moment_load
 from .spatial import (PointRule, assemble, axial_energy, check_material_section, clamp_coordinates,
-                    hermite_operator, translational_mass)
+                      hermite_operator, translational_mass)
 
-__all__ = ["BE3D"]
-
-# Per element: r_A 0:3, r'_A 3:6, theta_A 6, r_B 7:10, r'_B 10:13, theta_B 13.
-_DOF = np.array([[0, 1, 2], [3, 4, 5], [7, 8, 9], [10, 11, 12]])
-_THETA = np.array([6, 13])
-_NDOF = 14
-# Smallest admissible sine of the angle between director and axis in the reference configuration.
-_PARALLEL_TOL = 1e-6
+__all__ = ["BE3D", "BE3DReference"]
 
 
-class BE3D(KernelOption, BE3DEvents, Element):
+class BE3DReference(Kernel):
+    """The NumPy reference of BE3D's kernels: strain energy, forces and tangent, rotary inertia, dead moment.
+
+    The residual path writes the chain rule out (:func:`.be3d_kinematics.curvature_energy`); the tangent
+    propagates scalar jets (:func:`.be3d_kinematics.curvatures`). The compiled twin is
+    :class:`~.be3d_numba.BE3DCompiled`.
+    """
+
+    name = "numpy"
+
+    def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
+        """Axial plus bending-torsion energy per element (class docstring of :class:`BE3D`)."""
+        el = self.element
+        U, _, _ = axial_energy(geom["axial"], q, geom["slope_ref"], el.EA, False)
+        W, _ = curvature_energy(*local_variables(geom["directors"], q, geom["bend"]), geom["k_ref"],
+                                el.curvature_stiffness)
+        return U + np.sum(geom["bend"].wdx * W, axis=1)
+
+    def internal_forces(self, geom: dict, q: np.ndarray,
+                        tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """``f = dU/dq_e`` (n_el, 14) and, if ``tangent``, ``K = df/dq_e`` (n_el, 14, 14)."""
+        el = self.element
+        _, f, K = axial_energy(geom["axial"], q, geom["slope_ref"], el.EA, tangent)
+        rule = geom["bend"]
+        local = local_variables(geom["directors"], q, rule)
+        if not tangent:
+            # residual path: the chain rule written out, no Hessians
+            _, grad = curvature_energy(*local, geom["k_ref"], el.curvature_stiffness)
+            return f + np.einsum("epvn,epv->en", rule.Bx, grad * rule.wdx[..., None]), None
+        grad = 0.0
+        hess = 0.0
+        for i, ki in enumerate(curvatures(*local, order=2)):
+            wi = el.curvature_stiffness[i] * rule.wdx
+            ri = (ki.v - geom["k_ref"][..., i]) * wi
+            grad = grad + ri[..., None] * ki.g
+            hess = hess + ri[..., None, None] * ki.h + wi[..., None, None] * (ki.g[..., :, None] * ki.g[..., None, :])
+        f = f + np.einsum("epvn,epv->en", rule.Bx, grad)
+        return f, K + assemble(rule.Bx, hess)
+
+    def moment_load(self, geom: dict, q: np.ndarray, s: float, moment: np.ndarray, element: int,
+                    tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """The dead moment of :func:`.be3d_moment.moment_load`."""
+        return moment_load(geom, q, s, moment, element, tangent)
+
+    def inertia(self, geom: dict, q: np.ndarray, v: np.ndarray, a: np.ndarray, tangent: bool = True) -> tuple:
+        """The rotary inertia of :func:`.be3d_inertia.rotary_inertia`."""
+        return rotary_inertia(geom["inertia"], geom, q, v, a, self.element.rhoJ, tangent)
+
+    def kinetic_energy(self, geom: dict, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """The rotary kinetic energy of :func:`.be3d_inertia.rotary_kinetic_energy`."""
+        return rotary_kinetic_energy(geom["inertia"], geom, q, v, self.element.rhoJ)
+
+
+def _compiled(element: BE3D) -> Kernel:
+    """The compiled kernel object; its module, and numba's loops with it, is imported when selected."""
+    from .be3d_numba import BE3DCompiled
+    return BE3DCompiled(element)
+
+
+class BE3D(Element):
     """Spatial thin ANCF beam with torsional stiffness (chapter Sects. 3.5-3.6).
 
     Frame (Eqs. 96-100): ``e1 = r'/|r'|``; ``e30`` the normalised projection
@@ -60,7 +113,7 @@ class BE3D(KernelOption, BE3DEvents, Element):
     Inertia: the axis' translation (constant mass matrix) plus the spin of
     the cross-section about the axis, ``1/2 int rho J omega1^2``, which makes
     ``M`` depend on ``q`` and adds gyroscopic forces; derivation in
-    :mod:`._be3d_dynamics`.
+    :mod:`.be3d_inertia`.
 
     Parameters
     ----------
@@ -68,10 +121,11 @@ class BE3D(KernelOption, BE3DEvents, Element):
     section : RectangularSection or CircularSection
         Uses ``A``, ``I2``, ``I3``, ``J = I2 + I3`` and ``k_t``.
     director_update : {"projected", "post-rotated", "none"}
-        Update of the nodal directors after an accepted step (Sect. 3.6): a
-        model event (:meth:`step_event`); the directors are the beam's event
-        state, carried by the driver and kept in ``Result.model_state``. With ``"post-rotated"`` the update is
-        also applied to the reference configuration (director ``e3``,
+        Update of the nodal directors after an accepted step (Sect. 3.6,
+        :mod:`.be3d_directors`): a model event (:meth:`step_event`); the
+        directors are the beam's event state, carried by the driver and kept
+        in ``Result.model_state``. With ``"post-rotated"`` the update is also
+        applied to the reference configuration (director ``e3``,
         ``theta = 0``), so that the values fixed by supports stay valid.
     director : array_like (3,), optional
         Initial director of every node; default ``e3`` of each node's
@@ -95,18 +149,32 @@ class BE3D(KernelOption, BE3DEvents, Element):
         with the mesh (O(h^2) in the strain energy): on this 2-element mesh
         the tip of B after 3 s differed by 2e-2 m between the update after
         every step (Lobatto IIIA, h = 1e-3) and none.
-    kernel : {"auto", "numpy", "numba"}
+    kernel : {"auto", "numba", "numpy"}
         Implementation of the strain energy, internal forces, rotary inertia
-        and dead-moment load. ``"numba"``: compiled loops over elements x
-        points (:mod:`._be3d_numba`, :mod:`._be3d_inertia_numba`,
-        :mod:`._be3d_moment_numba`; the first call compiles or loads the
-        on-disk cache). ``"numpy"``: vectorised NumPy,
-        the readable reference (same results to rounding). ``"auto"``
-        (default): numba when importable. Settable later through the
-        ``kernel`` attribute.
+        and dead-moment load. ``"numba"`` and ``"auto"`` (the default):
+        compiled loops over elements x points
+        (:class:`~.be3d_numba.BE3DCompiled`; the first call compiles or loads
+        the on-disk cache). ``"numpy"``: vectorised NumPy
+        (:class:`BE3DReference`), the readable reference (same results to
+        rounding). Settable later through the ``kernel`` attribute.
+
+    Attributes
+    ----------
+    EA : float
+        Axial stiffness.
+    curvature_stiffness : ndarray (3,)
+        ``(G J k_t, E I2, E I3)``: the stiffnesses of the twist ``k1`` and the
+        curvatures ``k2, k3`` (the diagonal of Eqs. 42/111).
     """
 
+
     name = "BE3D"
+    dim = 3
+    node_params = (-1.0, 1.0)
+    node_coordinates = ("x", "y", "z", "x'", "y'", "z'", "theta")
+    mass_is_constant = False
+    kernel_twins = {"numpy": BE3DReference, "numba": _compiled}
+
     dim = 3
     node_params = (-1.0, 1.0)
     node_coordinates = ("x", "y", "z", "x'", "y'", "z'", "theta")
@@ -119,7 +187,7 @@ class BE3D(KernelOption, BE3DEvents, Element):
         check_material_section(material, section, ("A", "I2", "I3", "J", "k_t"))
         self.material = material
         self.section = section
-        self.director_update = choice("director_update", director_update, UPDATES)
+        self.director_update = choice("director_update", director_update, directors_.UPDATES)
         if update_below is not None and (isinstance(update_below, bool) or not isinstance(update_below, (int, float))
                                          or not 0.0 < update_below <= 1.0):
             raise ValueError(f"`update_below` must be None or a number in (0, 1], got {update_below!r}.")
@@ -134,10 +202,9 @@ class BE3D(KernelOption, BE3DEvents, Element):
         self.inertia_points = positive_int("inertia_points", inertia_points)
         E, G = material.E, material.G
         self.EA = E * section.A
-        self.D = np.array([G * section.J * section.k_t, E * section.I2, E * section.I3])
+        self.curvature_stiffness = np.array([G * section.J * section.k_t, E * section.I2, E * section.I3])
         self.rhoA = material.rho * section.A
         self.rhoJ = material.rho * section.J
-        self._pending = None
         self.kernel = kernel
 
     def __repr__(self):
@@ -147,26 +214,14 @@ class BE3D(KernelOption, BE3DEvents, Element):
 
     # -- mesh -------------------------------------------------------------
     def reference_coordinates(self, points: np.ndarray, frames_: np.ndarray) -> np.ndarray:
-        """``(r, e1, theta_ref)`` per node; keeps the initial nodal directors for :meth:`prepare`.
+        """``(r, e1, theta_ref)`` per node, ``theta_ref`` from :func:`.be3d_directors.reference_directors`."""
+        _, theta = directors_.reference_directors(self.director, self.director_update, frames_)
+        return np.concatenate([points, np.asarray(frames_, dtype=float)[:, :, 0], theta[:, None]], axis=1)
 
-        The director is ``e3`` of each node's frame (``theta_ref = 0``), or the
-        given ``director`` with ``theta_ref`` the angle that turns its
-        projected frame ``(e20, e30)`` into the node's ``(e2, e3)``.
-        """
-        frames_ = np.asarray(frames_, dtype=float)
-        e1, e2, e3 = frames_[:, :, 0], frames_[:, :, 1], frames_[:, :, 2]
-        theta = np.zeros(len(points))
-        if self.director is not None:
-            D = np.repeat(self.director[None, :], len(points), axis=0)
-            _check_director(D, e1)
-        if self.director is None or self.director_update == "post-rotated":
-            D = e3.copy()
-        else:
-            F, _ = frames(e1, theta, D)
-            # e3 = cos(theta) e30 - sin(theta) e20 and e2 = cos(theta) e20 + sin(theta) e30
-            theta = np.arctan2(np.einsum("ni,ni->n", e2, F[:, :, 2]), np.einsum("ni,ni->n", e3, F[:, :, 2]))
-        self._pending = D
-        return np.concatenate([points, e1, theta[:, None]], axis=1)
+    def reference_state(self, points: np.ndarray, frames_: np.ndarray) -> dict:
+        """``{"directors": (n_nodes, 3)}``: the nodal directors of the undeformed beam, for :meth:`prepare`."""
+        directors, _ = directors_.reference_directors(self.director, self.director_update, frames_)
+        return {"directors": directors}
 
     def support_coordinates(self, kind: str, frame: np.ndarray) -> tuple[str, ...]:
         """``"pin"``: r; ``"clamp"``: r, the slope components transverse to the reference tangent, theta.
@@ -176,178 +231,78 @@ class BE3D(KernelOption, BE3DEvents, Element):
         """
         return clamp_coordinates(kind, frame, ("theta",) if kind == "clamp" else ())
 
-    def _rule(self, n_points, lengths):
-        rule = PointRule(n_points, lengths, _DOF, _NDOF)
-        N, dN = linear(rule.s, lengths)
-        rule.Nt = np.zeros(N.shape[:2] + (_NDOF,))
-        rule.Nt[..., _THETA] = N
-        rule.dNt = np.zeros(N.shape[:2] + (_NDOF,))
-        rule.dNt[..., _THETA] = dN
-        rule.lin = N[0]
-        rule.L = lengths
-        rule.Bx = np.concatenate([rule.Ba, rule.Bb, rule.Nt[:, :, None, :], rule.dNt[:, :, None, :]], axis=2)
-        return rule
-
-    def prepare(self, q_ref: np.ndarray, lengths: np.ndarray) -> dict:
+    def prepare(self, q_ref: np.ndarray, lengths: np.ndarray, directors: ArrayLike | None = None) -> dict:
+        """The geometry, with the nodal ``directors`` (n_el + 1, 3) of :meth:`reference_state` (None: fallback
+        directors of :func:`.be3d_directors.fallback_directors`, e.g. for stacked copies of a mesh)."""
         q_ref = np.asarray(q_ref, dtype=float)
         lengths = np.asarray(lengths, dtype=float)
-        n_el = lengths.size
-        D = self._pending
-        self._pending = None
-        if D is None or D.shape[0] != n_el + 1:
-            D = self._fallback_directors(q_ref)
-        D = np.array(D, dtype=float)
-        D.setflags(write=False)   # event state: replaced (Beam.bind), never changed in place
-        geom = {"L": lengths, "directors": D,
-                "axial": PointRule(self.axial_points, lengths, _DOF, _NDOF),
-                "bend": self._rule(self.bending_points, lengths),
-                "inertia": self._rule(self.inertia_points, lengths),
-                "M": translational_mass(lengths, _DOF, _NDOF, self.rhoA)}
+        if directors is None:
+            directors = directors_.fallback_directors(self.director, q_ref)
+        directors = np.array(directors, dtype=float)
+        if directors.shape != (lengths.size + 1, 3):
+            raise ValueError(f"`directors` must have shape {(lengths.size + 1, 3)} (one per node), "
+                             f"got {directors.shape}.")
+        directors.setflags(write=False)   # event state: replaced (Beam.bind), never changed in place
+        geom = {"L": lengths, "directors": directors,
+                "axial": PointRule(self.axial_points, lengths, DOF, N_EDOF),
+                "bend": TorsionRule(self.bending_points, lengths),
+                "inertia": TorsionRule(self.inertia_points, lengths),
+                "M": translational_mass(lengths, DOF, N_EDOF, self.rhoA)}
         a = np.einsum("epin,en->epi", geom["axial"].Ba, q_ref)
         geom["slope_ref"] = np.linalg.norm(a, axis=-1)
         for key in ("bend", "inertia"):
             rule = geom[key]
             d, _ = director_field(geom["directors"], rule)
-            _check_director(d.reshape(-1, 3), np.einsum("epin,en->epi", rule.Ba, q_ref).reshape(-1, 3))
-        geom["k_ref"] = np.stack([k.v for k in self._curvatures(geom, q_ref, 1)], axis=-1)
+            directors_.check_director(d.reshape(-1, 3), np.einsum("epin,en->epi", rule.Ba, q_ref).reshape(-1, 3))
+        local = local_variables(geom["directors"], q_ref, geom["bend"])
+        geom["k_ref"] = np.stack([k.v for k in curvatures(*local, order=1)], axis=-1)
         return geom
 
-    def _fallback_directors(self, q_ref):
-        """Directors when :meth:`prepare` is called without :meth:`reference_coordinates` first.
-
-        The given ``director`` if any, else per node the global axis least
-        aligned with the reference slope.
-        """
-        slopes = np.concatenate([q_ref[:, 3:6], q_ref[-1:, 10:13]])
-        if self.director is not None:
-            return np.repeat(self.director[None, :], len(slopes), axis=0)
-        return np.eye(3)[np.argmin(np.abs(slopes), axis=1)]
-
-    # -- kernels ----------------------------------------------------------
-    @staticmethod
-    def _local(geom, q, rule):
-        """Slope, its derivative, angle, its derivative, director and its derivative at a rule's points."""
-        d, dp = director_field(geom["directors"], rule)
-        a = np.einsum("epin,en->epi", rule.Ba, q)
-        b = np.einsum("epin,en->epi", rule.Bb, q)
-        th = np.einsum("epn,en->ep", rule.Nt, q)
-        dth = np.einsum("epn,en->ep", rule.dNt, q)
-        return a, b, th, dth, d, np.broadcast_to(dp, d.shape)
-
-    def _curvatures(self, geom, q, order, rule=None):
-        return curvatures(*self._local(geom, q, geom["bend"] if rule is None else rule), order=order)
+    # -- fields at given points (diagnostics: exports, plots, tests) -------
+    def _points(self, geom, s):
+        return TorsionRule(np.atleast_1d(np.asarray(s, dtype=float)), geom["L"])
 
     def curvature(self, geom: dict, q: np.ndarray, s: ArrayLike) -> np.ndarray:
         """Twist and curvatures ``(k1, k2, k3)`` per xi at normalised coordinates ``s``, shape (n_el, n_pts, 3)."""
-        rule = self._rule(np.atleast_1d(np.asarray(s, dtype=float)), geom["L"])
-        return np.stack([k.v for k in self._curvatures(geom, q, 1, rule)], axis=-1)
+        local = local_variables(geom["directors"], q, self._points(geom, s))
+        return np.stack([k.v for k in curvatures(*local, order=1)], axis=-1)
 
     def spin(self, geom: dict, q: np.ndarray, v: np.ndarray, s: ArrayLike) -> np.ndarray:
         """Angular velocity of the cross-section about the axis, ``omega . e1``, shape (n_el, n_pts)."""
-        rule = self._rule(np.atleast_1d(np.asarray(s, dtype=float)), geom["L"])
+        rule = self._points(geom, s)
         a = np.einsum("epin,en->epi", rule.Ba, q)
         d, _ = director_field(geom["directors"], rule)
         g, _ = spin_gradient(a, d)
         return np.einsum("epn,en->ep", rule.Nt, v) + np.einsum("epi,epin,en->ep", g, rule.Ba, v)
 
+    def frames(self, geom: dict, q: np.ndarray, s: ArrayLike) -> np.ndarray:
+        """Cross-section frames at normalised coordinates ``s``, shape (n_el, n_pts, 3, 3), columns e1, e2, e3."""
+        a, _, th, _, d, _ = local_variables(geom["directors"], q, self._points(geom, s))
+        F, _ = frames(a, th, d)
+        return F
+
+    # -- kernels ----------------------------------------------------------
     def mass_matrix(self, geom: dict) -> np.ndarray:
         """Constant part ``rho A int S^T S dxi`` (zero rows and columns for theta)."""
         return geom["M"]
 
-    @staticmethod
-    def _directors(geom):
-        """The nodal directors (n_nodes, 3) the compiled kernels take as input (C-contiguous floats)."""
-        return np.ascontiguousarray(geom["directors"], dtype=float)
-
-    def _compiled_forces(self, geom, q, tangent):
-        """(U, f, K) from the compiled kernel, with the nodal directors of ``geom``."""
-        from .be3d_numba import be3d_forces
-        ax, bd = geom["axial"], geom["bend"]
-        return be3d_forces(np.ascontiguousarray(q, dtype=float), _DOF, _THETA, ax.dN, ax.wdx, geom["slope_ref"],
-                           bd.dN, bd.ddN, bd.wdx, bd.lin, geom["L"], self._directors(geom),
-                           geom["k_ref"], self.D, self.EA, bool(tangent))
-
     def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
-        if self._impl == "numba":
-            return self._compiled_forces(geom, q, False)[0]
-        U, _, _ = axial_energy(geom["axial"], q, geom["slope_ref"], self.EA, False)
-        W, _ = curvature_energy(*self._local(geom, q, geom["bend"]), geom["k_ref"], self.D)
-        return U + np.sum(geom["bend"].wdx * W, axis=1)
+        return self.kernels.strain_energy(geom, q)
 
     def internal_forces(self, geom: dict, q: np.ndarray,
                         tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        if self._impl == "numba":
-            _, f, K = self._compiled_forces(geom, q, tangent)
-            return f, (K if tangent else None)
-        _, f, K = axial_energy(geom["axial"], q, geom["slope_ref"], self.EA, tangent)
-        rule = geom["bend"]
-        if not tangent:
-            # residual path: the chain rule written out, no Hessians
-            _, grad = curvature_energy(*self._local(geom, q, rule), geom["k_ref"], self.D)
-            return f + np.einsum("epvn,epv->en", rule.Bx, grad * rule.wdx[..., None]), None
-        grad = 0.0
-        hess = 0.0
-        for i, ki in enumerate(self._curvatures(geom, q, 2)):
-            wi = self.D[i] * rule.wdx
-            ri = (ki.v - geom["k_ref"][..., i]) * wi
-            grad = grad + ri[..., None] * ki.g
-            hess = hess + ri[..., None, None] * ki.h + wi[..., None, None] * (ki.g[..., :, None] * ki.g[..., None, :])
-        f = f + np.einsum("epvn,epv->en", rule.Bx, grad)
-        return f, K + assemble(rule.Bx, hess)
+        return self.kernels.internal_forces(geom, q, tangent)
 
     def shape_matrix(self, s: ArrayLike, lengths: ArrayLike) -> np.ndarray:
         N, _, _ = hermite(np.asarray(s, dtype=float), np.asarray(lengths, dtype=float))
-        return hermite_operator(N, _DOF, _NDOF)
-
-    def frames(self, geom: dict, q: np.ndarray, s: ArrayLike) -> np.ndarray:
-        """Cross-section frames at normalised coordinates ``s``, shape (n_el, n_pts, 3, 3), columns e1, e2, e3."""
-        rule = self._rule(np.atleast_1d(np.asarray(s, dtype=float)), geom["L"])
-        a, _, th, _, d, _ = self._local(geom, q, rule)
-        F, _ = frames(a, th, d)
-        return F
+        return hermite_operator(N, DOF, N_EDOF)
 
     def moment_load(self, geom: dict, q: np.ndarray, s: float, moment: np.ndarray, element: int,
                     tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        """Dead moment at ``s``: ``f = G^T M`` with the virtual rotation of the frame.
+        """Dead moment at ``s``: ``f = G^T M`` with the virtual rotation of the frame (:mod:`.be3d_moment`)."""
+        return self.kernels.moment_load(geom, q, s, finite_vector("moment", moment, 3), element, tangent)
 
-        ``delta phi = e1 x delta e1 + (delta theta + g . delta r') e1``
-        (the bending part and the spin of Eqs. 96-100 under a variation, see
-        :mod:`._be3d_dynamics` for ``g``), hence
-        ``f_r' = (M x e1)/|r'| + g (M . e1)`` and ``f_theta = M . e1``.
-        """
-        M = finite_vector("moment", moment, 3)
-        if self._impl == "numba":
-            from .be3d_moment_numba import be3d_moment
-            D = self._directors(geom)
-            f, K = be3d_moment(np.ascontiguousarray(q, dtype=float), _DOF, _THETA, float(s), float(geom["L"][element]),
-                               D[element], D[element + 1], M, bool(tangent))
-            return f, (K if tangent else None)
-        L = geom["L"][[element]]
-        s_ = np.array([float(s)])
-        _, dN, _ = hermite(s_, L)
-        N, _ = linear(s_, L)
-        Sx = hermite_operator(dN, _DOF, _NDOF)[0, 0]
-        Nt = np.zeros(_NDOF)
-        Nt[_THETA] = N[0, 0]
-        D = geom["directors"]
-        d = N[0, 0, 0] * D[element] + N[0, 0, 1] * D[element + 1]
-        a = Sx @ q
-        I = np.eye(3)
-        aj = [Jet(a[i], I[i]) for i in range(3)]
-        sp = jet.sqrt(aj[0] * aj[0] + aj[1] * aj[1] + aj[2] * aj[2])
-        e1 = [x / sp for x in aj]
-        Me1 = M[0] * e1[0] + M[1] * e1[1] + M[2] * e1[2]
-        Mxe1 = [M[1] * e1[2] - M[2] * e1[1], M[2] * e1[0] - M[0] * e1[2], M[0] * e1[1] - M[1] * e1[0]]
-        g, G = spin_gradient(a, d)
-        gj = [Jet(g[i], G[i]) for i in range(3)]
-        fa = [Mxe1[i] / sp + gj[i] * Me1 for i in range(3)]
-        f = Sx.T @ np.array([x.v for x in fa]) + Nt * Me1.v
-        if not tangent:
-            return f, None
-        dfa = np.array([x.g for x in fa])
-        return f, Sx.T @ dfa @ Sx + np.outer(Nt, Me1.g @ Sx)
-
-    def inertia(self, geom: dict, q: np.ndarray, v: np.ndarray, a: np.ndarray, jacobian: bool = True) -> tuple:
+    def inertia(self, geom: dict, q: np.ndarray, v: np.ndarray, a: np.ndarray, tangent: bool = True) -> tuple:
         """Rotary inertia about the axis: ``f``, and ``df/dq, df/dv, df/da`` (exact).
 
         From ``T_rot = 1/2 int rho J omega1^2 dxi`` with the spin
@@ -355,34 +310,27 @@ class BE3D(KernelOption, BE3DEvents, Element):
         equations give ``f = int rho J [w Omega + omega1 Sx^T (G - G^T) r'_dot]``,
         ``Omega = w . a + r'_dot^T G r'_dot``, ``G = dg/dr'``: the mass term
         ``M_rot(q) a`` plus gyroscopic terms (derivation in
-        :mod:`._be3d_dynamics`). Returns ``(f, None, None, None)`` when
-        ``jacobian`` is False.
+        :mod:`.be3d_inertia`). Returns ``(f, None, None, None)`` when
+        ``tangent`` is False.
         """
-        if self._impl == "numba":
-            from .be3d_inertia_numba import be3d_inertia
-            rule = geom["inertia"]
-            f, Kq, Dv, Ma = be3d_inertia(*(np.ascontiguousarray(x, dtype=float) for x in (q, v, a)), _DOF, _THETA,
-                                         rule.dN, rule.wdx, rule.lin, self._directors(geom), self.rhoJ,
-                                         bool(jacobian))
-            return (f, Kq, Dv, Ma) if jacobian else (f, None, None, None)
-        return rotary_inertia(geom["inertia"], geom, q, v, a, self.rhoJ, jacobian)
+        return self.kernels.inertia(geom, q, v, a, tangent)
 
     def kinetic_energy_extra(self, geom: dict, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``1/2 int rho J omega1^2 dxi`` per element."""
-        if self._impl == "numba":
-            from .be3d_inertia_numba import be3d_kinetic_energy
-            rule = geom["inertia"]
-            return be3d_kinetic_energy(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(v, dtype=float),
-                                       _DOF, _THETA, rule.dN, rule.wdx, rule.lin, self._directors(geom),
-                                       self.rhoJ)
-        return rotary_kinetic_energy(geom["inertia"], geom, q, v, self.rhoJ)
+        return self.kernels.kinetic_energy(geom, q, v)
 
+    # -- the director event (Sect. 3.6) -------------------------------------
+    def event_state(self, geom: dict) -> dict:
+        """``{"directors": (n_nodes, 3)}``: the nodal directors, carried by the driver between steps."""
+        return {"directors": geom["directors"]}
 
-def _check_director(d, e1):
-    """Raise ValueError where a director is (nearly) parallel to the axis."""
-    sin = np.linalg.norm(np.cross(d, e1), axis=-1) / (np.linalg.norm(d, axis=-1) * np.linalg.norm(e1, axis=-1))
-    bad = np.flatnonzero(~(sin > _PARALLEL_TOL))
-    if bad.size:
-        raise ValueError(f"`director` must not be parallel to the beam axis (chapter Eq. 99 would be singular); "
-                         f"sine of the angle {sin[bad[0]]:.3g} at point/node {int(bad[0])}, director "
-                         f"{d[bad[0]].tolist()}, axis {e1[bad[0]].tolist()}.")
+    def bind(self, geom: dict, state: dict) -> dict:
+        """``geom`` with the nodal directors of ``state`` (read-only; ``geom`` itself is unchanged)."""
+        return directors_.bind(geom, state)
+
+    def step_event(self, geom: dict, Q: np.ndarray, V: np.ndarray) -> tuple | None:
+        """Director update of Sect. 3.6 (``director_update``, ``update_below``); None when not done.
+
+        See :func:`.be3d_directors.update_directors`.
+        """
+        return directors_.step(geom, Q, V, self.director_update, self.update_below)

@@ -1,4 +1,4 @@
-"""BE3D's configuration-dependent inertia and its director update (chapter Sects. 2.2, 3.5, 3.6).
+"""BE3D's configuration-dependent inertia in NumPy: the rotary inertia about the axis (chapter Sects. 2.2, 3.5).
 
 Kinetic energy and inertia forces
 ---------------------------------
@@ -11,7 +11,7 @@ neglected, as in every Bernoulli-Euler ANCF element)::
     g(a)   = (a.d) (d x a) / (|a| |d x a|^2)               (d: director).
 
 ``omega1 = e2_dot . e3`` follows from Eqs. 96-100 exactly like the twist
-``k1`` (see :mod:`._be3d_kinematics`), with the director constant in time
+``k1`` (see :mod:`.be3d_kinematics`), with the director constant in time
 between updates. With the element coordinates ``q`` and, at a point,
 ``a = Ba q``, ``theta = Nt q``, the spin is linear in the velocities,
 ``omega1 = w(q) . v`` with ``w = Nt + Ba^T g(a)``, so
@@ -29,48 +29,14 @@ semi-discrete equations derive from the Lagrangian ``T - U`` (both evaluated
 with the same quadrature rules), ``d/dt (T + U) = v . f_ext``: the model
 conserves energy between director updates. The Jacobian blocks need ``H =
 d2g/da2`` and are exact (jets).
-
-Director update
----------------
-After an accepted step (chapter Sect. 3.6), per global node with slope ``a``,
-angle ``theta`` and director ``d``:
-
-* ``"projected"``: ``d <- e30`` (Eq. 99 at the node), ``theta`` unchanged;
-* ``"post-rotated"``: ``d <- e3`` and ``theta <- 0``;
-* ``"none"``: no update.
-
-Either update leaves the nodal frame unchanged, and sets ``theta_dot`` to the
-node's physical spin ``omega1`` (with the new director ``d . e1 = 0``, hence
-``g = 0``), so nodal positions, slopes, frames and spins are unchanged, and a
-second update right after the first changes nothing. Inside an element the
-frame depends on the *interpolated* director, so an update changes the
-interior frames, the strain and the kinetic energy: by O(h^2) (h the element
-length) for a given deformed state, and not at all for motions in the plane
-normal to the director. This cannot be avoided with the chapter's linear
-interpolation of directors and angle.
-
-Consequence for dynamics (chapter Sect. 5.3): between updates the equations
-conserve ``T + U``; every update adds a jump. With an update after every
-time step the jumps accumulate at a rate independent of the step size, and
-they grow when neighbouring nodal directors drift apart (the projected
-directors by the holonomy of each node's tangent path, the post-rotated ones
-by the physical twist and bending between nodes), because their linear
-interpolation then shrinks towards zero and the interior frames turn fast.
-This is the energy blow-up of BE3D; without updates the energy stays
-conserved until the axis meets the fixed director (Eq. 99 singular).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from .be3d_kinematics import director_field, frames, spin_coefficients, spin_gradient
+from .be3d_kinematics import director_field, spin_coefficients, spin_gradient
 
-__all__ = ["rotary_inertia", "rotary_kinetic_energy", "update_directors", "director_sines", "UPDATES"]
-
-UPDATES = ("projected", "post-rotated", "none")
-
-# Below this sine of the angle between director and axis, a node's frame is undefined.
-_SINGULAR = 1e-12
+__all__ = ["rotary_inertia", "rotary_kinetic_energy"]
 
 
 def _spin_parts(rule, geom, q, order):
@@ -124,40 +90,3 @@ def rotary_inertia(rule, geom, q, v, acc, rhoJ, tangent=True):
     dfdq = np.sum(Wm * ((BaT @ G @ Ba) * Om[..., None, None] + outer(w, dOm) + outer(c, dom)
                         + om[..., None, None] * (BaT @ A2 @ Ba)), axis=1)
     return f, dfdq, dfdv, dfda
-
-
-def director_sines(D, Q):
-    """Sine of the angle between each nodal director and the axis ``r'`` (1 = normal, 0 = parallel)."""
-    a = Q[:, 3:6]
-    return np.linalg.norm(np.cross(D, a), axis=-1) / (np.linalg.norm(D, axis=-1) * np.linalg.norm(a, axis=-1))
-
-
-def update_directors(D, Q, V, variant):
-    """The director update; return the new ``(Q, V, D)`` (the arguments are not changed).
-
-    ``D``: nodal directors, shape (n_nodes, 3); ``Q``, ``V``: nodal coordinates and velocities,
-    shape (n_nodes, 7), per node ``(x, y, z, x', y', z', theta)``.
-    """
-    if variant == "none":
-        return Q, V, D
-    a = Q[:, 3:6]
-    with np.errstate(invalid="ignore", divide="ignore"):   # a singular node is reported below
-        F, n = frames(a, Q[:, 6], D)
-    bad = np.flatnonzero(~(n > _SINGULAR))
-    if bad.size:
-        raise FloatingPointError(
-            f"BE3D director update: the director is parallel to the beam axis at node(s) {bad.tolist()} "
-            "(the projection of chapter Eq. 99 is singular); use smaller steps so the update follows the axis.")
-    g, _ = spin_gradient(a, D)
-    omega1 = V[:, 6] + np.einsum("ni,ni->n", g, V[:, 3:6])
-    Q, V = Q.copy(), V.copy()
-    if variant == "projected":
-        # e30 (Eq. 99): turn e3 back by theta, since e3 = c e30 - s e20 and e2 = c e20 + s e30.
-        c, s = np.cos(Q[:, 6])[:, None], np.sin(Q[:, 6])[:, None]
-        D = c * F[:, :, 2] + s * F[:, :, 1]
-    else:
-        D = F[:, :, 2].copy()
-        Q[:, 6] = 0.0
-    V[:, 6] = omega1
-    D.setflags(write=False)
-    return Q, V, D

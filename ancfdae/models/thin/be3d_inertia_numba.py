@@ -1,6 +1,6 @@
 """Compiled rotary inertia of BE3D: force, its exact derivatives K, D, M, and the kinetic energy.
 
-The same expressions as the NumPy reference :func:`._be3d_dynamics.rotary_inertia`
+The same expressions as the NumPy reference :func:`.be3d_inertia.rotary_inertia`
 (derivation in that module's docstring): with the spin
 ``omega1 = w(q) . v``, ``w = N_theta + Ba^T g(a)``,
 ``g(a) = (a.d)(d x a) / (|a| |d x a|^2)``, ``G = dg/da``, ``Hg = d2g/da2``,
@@ -11,7 +11,7 @@ The same expressions as the NumPy reference :func:`._be3d_dynamics.rotary_inerti
 and its derivatives with respect to the accelerations (``M``), velocities
 (``D``) and coordinates (``K``). Per point, ``g, G, Hg`` come from the jet of
 the scalar ``c = (a.d) / (|a| |d x a|^2)`` over ``a`` (three variables,
-:mod:`._jet_numba`): ``g = c m``, ``m = d x a = [d]_x a``. Products with the
+:mod:`ancfdae.models.jets.scalar_numba`): ``g = c m``, ``m = d x a = [d]_x a``. Products with the
 Hermite operator ``Ba`` use its sparsity: ``(Ba^T x)[dof[k, i]] += dN_k x_i``.
 """
 from __future__ import annotations

@@ -1,4 +1,8 @@
-"""Point kinematics of BE3D: cross-section frame, curvature and twist, spin about the axis.
+"""Kinematics of BE3D: its coordinate layout, point rules, cross-section frame, curvature and twist, spin.
+
+Element coordinates (Eqs. 62, 101-103): per node ``(r, r', theta)``, the axis
+by cubic Hermite functions and the torsion angle linearly; a
+:class:`TorsionRule` evaluates both at the points of a Gauss rule.
 
 Everything is written in the slope ``a = r'`` and its derivative ``b = r''``
 (per the element coordinate xi), the torsion angle ``theta`` and its
@@ -32,14 +36,45 @@ import numpy as np
 
 from ..jets import scalar as jet
 from ..jets.scalar import Jet
+from ..shapes import linear
+from .spatial import PointRule
 
-__all__ = ["curvatures", "curvature_energy", "spin_coefficients", "spin_gradient", "frames", "director_field",
-           "cross", "EPS"]
+__all__ = ["DOF", "THETA", "N_EDOF", "TorsionRule", "local_variables", "curvatures", "curvature_energy", "spin_coefficients",
+           "spin_gradient", "frames", "director_field", "cross", "EPS"]
+
+# Per element: r_A 0:3, r'_A 3:6, theta_A 6, r_B 7:10, r'_B 10:13, theta_B 13.
+DOF = np.array([[0, 1, 2], [3, 4, 5], [7, 8, 9], [10, 11, 12]])   # Hermite vector k, component i
+THETA = np.array([6, 13])                                          # the angle at A and B
+N_EDOF = 14
 
 # Levi-Civita symbol: (u x v)_i = EPS[i, j, k] u_j v_k
 EPS = np.zeros((3, 3, 3))
 EPS[0, 1, 2] = EPS[1, 2, 0] = EPS[2, 0, 1] = 1.0
 EPS[0, 2, 1] = EPS[2, 1, 0] = EPS[1, 0, 2] = -1.0
+
+
+class TorsionRule(PointRule):
+    """A Gauss rule (or given points) of BE3D: the axis operators of :class:`.spatial.PointRule` plus the
+    linear interpolation of the angle and the director (Eqs. 101-103, Sect. 3.6).
+
+    Attributes
+    ----------
+    theta : (2,) the element coordinates of the angle; Nt, dNt : (n_el, n_pts, 14) rows giving ``theta``
+    and ``theta'``; lin : (n_pts, 2) the linear functions ``(S5, S6)``; L : (n_el,) element lengths;
+    Bx : (n_el, n_pts, 8, 14) the map to the local variables ``(r', r'', theta, theta')``.
+    """
+
+    def __init__(self, n_points, lengths: np.ndarray):
+        super().__init__(n_points, lengths, DOF, N_EDOF)
+        N, dN = linear(self.s, lengths)
+        self.theta = THETA
+        self.Nt = np.zeros(N.shape[:2] + (N_EDOF,))
+        self.Nt[..., THETA] = N
+        self.dNt = np.zeros(N.shape[:2] + (N_EDOF,))
+        self.dNt[..., THETA] = dN
+        self.lin = N[0]
+        self.L = lengths
+        self.Bx = np.concatenate([self.Ba, self.Bb, self.Nt[:, :, None, :], self.dNt[:, :, None, :]], axis=2)
 
 
 def cross(u, v):
@@ -113,10 +148,10 @@ def curvatures(a, b, theta, dtheta, d, dp, order=2):
     return thp - tau0, s * X - c * Y, c * X + s * Y
 
 
-def curvature_energy(a, b, theta, dtheta, d, dp, k_ref, D):
+def curvature_energy(a, b, theta, dtheta, d, dp, k_ref, stiffness):
     """Bending-torsion energy density and its gradient, by the chain rule written out (residual path).
 
-    ``W = 1/2 sum_i D_i (k_i - k_ref_i)^2`` with the ``k_i`` of
+    ``W = 1/2 sum_i C_i (k_i - k_ref_i)^2`` (``C = stiffness``) with the ``k_i`` of
     :func:`curvatures`; the gradient is with respect to ``(a, b, theta,
     theta')``, shape (..., 8). Same values as the jets of :func:`curvatures`
     (the tests compare the two), a few times fewer array operations.
@@ -132,7 +167,8 @@ def curvature_energy(a, b, theta, dtheta, d, dp, k_ref, D):
     tau0 = (p * tp - ad * t) / (sp * m2)
     c, s = np.cos(theta), np.sin(theta)
     k1, k2, k3 = dtheta - tau0, s * X - c * Y, c * X + s * Y
-    r1, r2, r3 = (D[0] * (k1 - k_ref[..., 0]), D[1] * (k2 - k_ref[..., 1]), D[2] * (k3 - k_ref[..., 2]))
+    r1, r2, r3 = (stiffness[0] * (k1 - k_ref[..., 0]), stiffness[1] * (k2 - k_ref[..., 1]),
+                  stiffness[2] * (k3 - k_ref[..., 2]))
     W = 0.5 * (r1 * (k1 - k_ref[..., 0]) + r2 * (k2 - k_ref[..., 1]) + r3 * (k3 - k_ref[..., 2]))
     WX, WY, Wtau = r3 * c + r2 * s, r3 * s - r2 * c, -r1
     # partial derivatives of W through X, Y, tau0 with respect to the invariants
@@ -213,3 +249,14 @@ def director_field(directors, rule):
     d = rule.lin[None, :, 0, None] * dA[:, None, :] + rule.lin[None, :, 1, None] * dB[:, None, :]
     dp = ((dB - dA) / rule.L[:, None])[:, None, :]
     return d, dp
+
+
+def local_variables(directors, q, rule):
+    """``(a, b, theta, theta', d, d')`` at the points of a :class:`TorsionRule`: slope ``r'``, its derivative
+    ``r''``, the angle and its derivative, the director and its derivative (shapes (n_el, n_pts[, 3]))."""
+    d, dp = director_field(directors, rule)
+    a = np.einsum("epin,en->epi", rule.Ba, q)
+    b = np.einsum("epin,en->epi", rule.Bb, q)
+    th = np.einsum("epn,en->ep", rule.Nt, q)
+    dth = np.einsum("epn,en->ep", rule.dNt, q)
+    return a, b, th, dth, d, np.broadcast_to(dp, d.shape)

@@ -1,6 +1,6 @@
 """Compiled generalised force of a dead moment on BE3D, and its exact q-derivative.
 
-The same expressions as the NumPy reference :meth:`ancfdae.models.BE3D.moment_load`:
+The same expressions as the NumPy reference :func:`.be3d_moment.moment_load`:
 the virtual rotation of the frame at ``s`` is
 ``delta phi = e1 x delta e1 + (delta theta + g . delta r') e1`` (Eqs. 96-100
 under a variation), so with ``a = r'``, ``p = |a|^2``, ``e1 = a / |a|``:
@@ -9,7 +9,7 @@ under a variation), so with ``a = r'``, ``p = |a|^2``, ``e1 = a / |a|``:
     d f_r' / da = [M]_x / p - 2 (M x a) a^T / p^2 + (M . e1) G + g (d(M . e1)/da)^T,
     d(M . e1)/da = (M - (M . e1) e1) / |a|,
 
-with ``g``, ``G = dg/da`` of the spin (:mod:`._be3d_inertia_numba`). The
+with ``g``, ``G = dg/da`` of the spin (:mod:`.be3d_inertia_numba`). The
 Hermite functions at ``s`` are evaluated here (chapter Eq. 60, derivative
 per xi), so a call does no NumPy work.
 """

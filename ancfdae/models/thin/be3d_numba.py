@@ -1,9 +1,10 @@
-"""Compiled BE3D strain energy, internal forces and exact tangent (chapter Sects. 3.5-3.6).
+"""Compiled BE3D kernels: strain energy, internal forces and exact tangent (chapter Sects. 3.5-3.6), and the
+kernel object :class:`BE3DCompiled` that adds the compiled rotary inertia and dead moment.
 
-The same energy as the NumPy reference of :class:`ancfdae.models.BE3D`: the
+The same energy as the NumPy reference :class:`.be3d.BE3DReference`: the
 axial term of Eq. 16 at the axial points, and at the bending points
-``1/2 sum_i D_i (k_i - k_i,ref)^2`` with the twist and curvatures of the
-frame of Eqs. 96-100 (formulas in :mod:`._be3d_kinematics`),
+``1/2 sum_i C_i (k_i - k_i,ref)^2`` (``C``: the curvature stiffnesses) with the twist and curvatures of the
+frame of Eqs. 96-100 (formulas in :mod:`.be3d_kinematics`),
 
     k1 = theta' - tau0,  k2 = s X - c Y,  k3 = c X + s Y,
 
@@ -11,18 +12,24 @@ written in the invariants ``p = a.a``, ``a.d``, ``|d x a|^2``, ``a.b``,
 ``b.d``, ``b.(d x a)``, ``d'.(d x a)`` of the slope ``a = r'``, ``b = r''``
 and the interpolated director ``d``. Exact gradients and Hessians with
 respect to the eight local variables ``(a, b, theta, theta')`` come from the
-slot jets of :mod:`._jet_numba`. The nodal directors are an input array, so
-the kernel reads no state besides its arguments.
+slot jets of :mod:`ancfdae.models.jets.scalar_numba`. The nodal directors are
+an input array, so the kernel reads no state besides its arguments. BE3D offers
+no fused assembly entry point: the beam scatters its element arrays with
+``np.bincount``.
 """
 from __future__ import annotations
 
 import numpy as np
 from numba import njit
 
+from ..element import Kernel
 from ..jets import scalar_numba as jet
+from .be3d_inertia_numba import be3d_inertia, be3d_kinetic_energy
+from .be3d_moment_numba import be3d_moment
 from .spatial_numba import axial_point, hermite_map, scatter, slope
 
-__all__ = ["be3d_forces", "be3d_element", "be3d_scratch", "curvature_point", "N_SLOTS", "K1", "K2", "K3"]
+__all__ = ["BE3DCompiled", "be3d_forces", "be3d_element", "be3d_scratch", "curvature_point", "N_SLOTS", "K1", "K2",
+           "K3"]
 
 # Jet slots: inputs, then intermediates, then the results k1, k2, k3.
 (P, AD, M2, AB, BD, T, TP, SP, SM, R1, X, N1, N2, NY, R2, Y, N3, N4, NT, R3, TAU, W1, W2, K1, K2, K3) = range(26)
@@ -141,13 +148,13 @@ def be3d_scratch(tangent):
 
 
 @njit(cache=True, inline="always")
-def be3d_element(f, K, q, dof, theta, dNa, wa, slope_ref, dNb, ddNb, wb, lin, L, dA, dB, k_ref, Dk, EA,
+def be3d_element(f, K, q, dof, theta, dNa, wa, slope_ref, dNb, ddNb, wb, lin, L, dA, dB, k_ref, stiffness, EA,
                  tangent, scratch):
     """One element: adds ``dU/dq`` to ``f`` (14,) and, if ``tangent``, the stiffness to ``K``; returns U.
 
     ``theta`` (2,): element coordinates of the nodal angles; ``lin`` (n_b, 2):
     the linear functions at the bending points; ``dA, dB``: the element's
-    nodal directors; ``k_ref`` (n_b, 3); ``Dk = (G J k_t, E I2, E I3)``;
+    nodal directors; ``k_ref`` (n_b, 3); ``stiffness = (G J k_t, E I2, E I3)``;
     ``scratch`` from :func:`be3d_scratch`.
     """
     a, b, d, dp, idx, coef, grad, Hl, V, G, H = scratch
@@ -171,7 +178,7 @@ def be3d_element(f, K, q, dof, theta, dNa, wa, slope_ref, dNb, ddNb, wb, lin, L,
                 Hl[v, u] = 0.0
         for i in range(3):
             k = K1 + i
-            wi = Dk[i] * wb[p]
+            wi = stiffness[i] * wb[p]
             dk = V[k] - k_ref[p, i]
             ri = dk * wi
             U += 0.5 * ri * dk
@@ -193,7 +200,8 @@ def be3d_element(f, K, q, dof, theta, dNa, wa, slope_ref, dNb, ddNb, wb, lin, L,
 
 
 @njit(cache=True)
-def be3d_forces(q, dof, theta, dNa, wa, slope_ref, dNb, ddNb, wb, lin, L, directors, k_ref, Dk, EA, tangent):
+def be3d_forces(q, dof, theta, dNa, wa, slope_ref, dNb, ddNb, wb, lin, L, directors, k_ref, stiffness, EA,
+                tangent):
     """Energy (n_el,), forces (n_el, 14) and, if ``tangent``, stiffness (n_el, 14, 14) of all elements.
 
     ``directors`` (n_el + 1, 3): the nodal directors along the beam. Without
@@ -206,8 +214,62 @@ def be3d_forces(q, dof, theta, dNa, wa, slope_ref, dNb, ddNb, wb, lin, L, direct
     scratch = be3d_scratch(tangent)
     for e in range(n_el):
         U[e] = be3d_element(f[e], K[e if tangent else 0], q[e], dof, theta, dNa[e], wa[e], slope_ref[e],
-                            dNb[e], ddNb[e], wb[e], lin, L[e], directors[e], directors[e + 1], k_ref[e], Dk,
+                            dNb[e], ddNb[e], wb[e], lin, L[e], directors[e], directors[e + 1], k_ref[e], stiffness,
                             EA, tangent, scratch)
     if not tangent:
         K = K[:0]
     return U, f, K
+
+
+class BE3DCompiled(Kernel):
+    """The compiled kernel object of BE3D: :func:`be3d_forces`, and the compiled rotary inertia
+    (:mod:`.be3d_inertia_numba`) and dead moment (:mod:`.be3d_moment_numba`)."""
+
+    name = "numba"
+
+    def _forces(self, geom, q, tangent):
+        el = self.element
+        ax, bd = geom["axial"], geom["bend"]
+        return be3d_forces(np.ascontiguousarray(q, dtype=float), bd.dof_map, bd.theta, ax.dN, ax.wdx,
+                           geom["slope_ref"], bd.dN, bd.ddN, bd.wdx, bd.lin, geom["L"], _directors(geom),
+                           geom["k_ref"], el.curvature_stiffness, el.EA, bool(tangent))
+
+    def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
+        """As :meth:`.be3d.BE3DReference.strain_energy`, compiled."""
+        return self._forces(geom, q, False)[0]
+
+    def internal_forces(self, geom: dict, q: np.ndarray,
+                        tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """As :meth:`.be3d.BE3DReference.internal_forces`, compiled."""
+        _, f, K = self._forces(geom, q, tangent)
+        return f, (K if tangent else None)
+
+    def moment_load(self, geom: dict, q: np.ndarray, s: float, moment: np.ndarray, element: int,
+                    tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """As :meth:`.be3d.BE3DReference.moment_load`, compiled."""
+        rule = geom["bend"]
+        directors = _directors(geom)
+        f, K = be3d_moment(np.ascontiguousarray(q, dtype=float), rule.dof_map, rule.theta, float(s),
+                           float(geom["L"][element]), directors[element], directors[element + 1], moment,
+                           bool(tangent))
+        return f, (K if tangent else None)
+
+    def inertia(self, geom: dict, q: np.ndarray, v: np.ndarray, a: np.ndarray, tangent: bool = True) -> tuple:
+        """As :meth:`.be3d.BE3DReference.inertia`, compiled."""
+        rule = geom["inertia"]
+        f, Kq, Dv, Ma = be3d_inertia(*(np.ascontiguousarray(x, dtype=float) for x in (q, v, a)), rule.dof_map,
+                                     rule.theta, rule.dN, rule.wdx, rule.lin, _directors(geom),
+                                     self.element.rhoJ, bool(tangent))
+        return (f, Kq, Dv, Ma) if tangent else (f, None, None, None)
+
+    def kinetic_energy(self, geom: dict, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """As :meth:`.be3d.BE3DReference.kinetic_energy`, compiled."""
+        rule = geom["inertia"]
+        return be3d_kinetic_energy(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(v, dtype=float),
+                                   rule.dof_map, rule.theta, rule.dN, rule.wdx, rule.lin, _directors(geom),
+                                   self.element.rhoJ)
+
+
+def _directors(geom):
+    """The nodal directors (n_nodes, 3) as the compiled kernels take them (C-contiguous floats)."""
+    return np.ascontiguousarray(geom["directors"], dtype=float)

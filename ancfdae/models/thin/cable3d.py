@@ -12,13 +12,12 @@ from numpy.typing import ArrayLike
 
 from ..._validate import finite_vector, positive_int
 from ...materials import CircularSection, Material, RectangularSection
-from ..element import Element
-from .._kernel_option import KernelOption
+from ..element import Element, Kernel
 from ..shapes import hermite
 from .spatial import (PointRule, assemble, axial_energy, check_material_section, clamp_coordinates,
-                    hermite_operator, translational_mass)
+                      hermite_operator, translational_mass)
 
-__all__ = ["Cable3D"]
+__all__ = ["Cable3D", "Cable3DReference", "curvature_squared"]
 
 # Hermite vector k, component i -> element coordinate: (r_A, r'_A, r_B, r'_B) back to back.
 _DOF = np.arange(12).reshape(4, 3)
@@ -28,7 +27,78 @@ _SYM_RTOL = 1e-10
 _STRAIGHT_TOL = 1e-10
 
 
-class Cable3D(KernelOption, Element):
+def curvature_squared(rule: PointRule, q: np.ndarray) -> np.ndarray:
+    """``K^2 = |r' x r''|^2 / |r'|^4`` (Eq. 95) at the points of ``rule``, shape (n_el, n_pts)."""
+    a = np.einsum("epin,en->epi", rule.Ba, q)
+    b = np.einsum("epin,en->epi", rule.Bb, q)
+    p = np.einsum("...i,...i", a, a)
+    ab = np.einsum("...i,...i", a, b)
+    bb = np.einsum("...i,...i", b, b)
+    return (p * bb - ab**2) / p**2
+
+
+class Cable3DReference(Kernel):
+    """The NumPy reference of Cable3D's strain energy, internal forces and tangent (Eqs. 94-95).
+
+    The compiled twin is :class:`~.cable3d_numba.Cable3DCompiled`.
+    """
+
+    name = "numpy"
+
+    def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
+        """``EA/2 (|r'| - |r'_ref|)^2`` at the axial points plus ``EI/2 K^2`` at the bending points, per element."""
+        el = self.element
+        U, _, _ = axial_energy(geom["axial"], q, geom["slope_ref"], el.material.E * el.section.A, False)
+        rule = geom["bend"]
+        K2 = curvature_squared(rule, q)
+        return U + 0.5 * el.material.E * el.section.I3 * np.sum(rule.wdx * K2, axis=1)
+
+    def internal_forces(self, geom: dict, q: np.ndarray,
+                        tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """``f = dU/dq_e`` (n_el, 12) and, if ``tangent``, ``K = df/dq_e`` (n_el, 12, 12)."""
+        el = self.element
+        _, f, K = axial_energy(geom["axial"], q, geom["slope_ref"], el.material.E * el.section.A, tangent)
+        rule = geom["bend"]
+        EI = el.material.E * el.section.I3
+        a = np.einsum("epin,en->epi", rule.Ba, q)
+        b = np.einsum("epin,en->epi", rule.Bb, q)
+        p = np.einsum("...i,...i", a, a)[..., None]
+        ab = np.einsum("...i,...i", a, b)[..., None]
+        bb = np.einsum("...i,...i", b, b)[..., None]
+        # K^2 = g / p^2 with g = |a x b|^2 = p |b|^2 - (a.b)^2
+        g = p * bb - ab**2
+        ga = 2.0 * (a * bb - ab * b)
+        gb = 2.0 * (b * p - ab * a)
+        Fa = ga / p**2 - 4.0 * g * a / p**3
+        Fb = gb / p**2
+        c = 0.5 * EI * rule.wdx[..., None]
+        f = f + np.einsum("epin,epi->en", rule.Ba, c * Fa) + np.einsum("epin,epi->en", rule.Bb, c * Fb)
+        if not tangent:
+            return f, None
+        I = np.eye(3)
+        p2, p3, p4 = (p**2)[..., None], (p**3)[..., None], (p**4)[..., None]
+        outer = lambda u, v: u[..., :, None] * v[..., None, :]   # noqa: E731
+        gaa = 2.0 * (bb[..., None] * I - outer(b, b))
+        gab = 4.0 * outer(a, b) - 2.0 * outer(b, a) - 2.0 * ab[..., None] * I
+        gbb = 2.0 * (p[..., None] * I - outer(a, a))
+        Faa = (gaa / p2 - 4.0 * (outer(ga, a) + outer(a, ga)) / p3
+               + 24.0 * g[..., None] * outer(a, a) / p4 - 4.0 * g[..., None] * I / p3)
+        Fab = gab / p2 - 4.0 * outer(a, gb) / p3
+        Fbb = gbb / p2
+        H = np.concatenate([np.concatenate([Faa, Fab], -1), np.concatenate([np.swapaxes(Fab, -1, -2), Fbb], -1)],
+                           -2) * c[..., None]
+        B = np.concatenate([rule.Ba, rule.Bb], axis=2)                     # (n_el, n_pts, 6, 12)
+        return f, K + assemble(B, H)
+
+
+def _compiled(element: Cable3D) -> Kernel:
+    """The compiled kernel object; its module, and numba's loops with it, is imported when selected."""
+    from .cable3d_numba import Cable3DCompiled
+    return Cable3DCompiled(element)
+
+
+
+class Cable3D(Element):
     """Spatial thin ANCF beam without torsional stiffness (chapter Sect. 3.4).
 
     Strain energy (structural formulation, chapter Eqs. 37 and 40 with the
@@ -63,19 +133,20 @@ class Cable3D(KernelOption, Element):
     axial_points, bending_points : int
         Gauss points of the axial and the bending term; the defaults 5 and 3
         (orders 9 and 5, as for BE2D) reproduce the chapter's Table 2.
-    kernel : {"auto", "numpy", "numba"}
+    kernel : {"auto", "numba", "numpy"}
         Implementation of :meth:`strain_energy` and :meth:`internal_forces`.
-        ``"numba"``: one compiled loop over elements x points
-        (:mod:`ancfdae.models._cable3d_numba`; the first call compiles or loads
-        the on-disk cache). ``"numpy"``: vectorised NumPy, the readable
-        reference (same results to rounding). ``"auto"`` (default): numba when
-        importable. Settable later through the ``kernel`` attribute.
+        ``"numba"`` and ``"auto"`` (the default): one compiled loop over
+        elements x points (:class:`~.cable3d_numba.Cable3DCompiled`; the first
+        call compiles or loads the on-disk cache). ``"numpy"``: vectorised
+        NumPy (:class:`Cable3DReference`), the readable reference (same
+        results to rounding). Settable later through the ``kernel`` attribute.
     """
 
     name = "Cable3D"
     dim = 3
     node_params = (-1.0, 1.0)
     node_coordinates = ("x", "y", "z", "x'", "y'", "z'")
+    kernel_twins = {"numpy": Cable3DReference, "numba": _compiled}
 
     def __init__(self, material: Material, section: RectangularSection | CircularSection, axial_points: int = 5,
                  bending_points: int = 3, kernel: str = "auto") -> None:
@@ -115,7 +186,7 @@ class Cable3D(KernelOption, Element):
                 "M": translational_mass(lengths, _DOF, 12, self.material.rho * self.section.A)}
         a = np.einsum("epin,en->epi", geom["axial"].Ba, q_ref)
         geom["slope_ref"] = np.linalg.norm(a, axis=-1)
-        K2 = self._curvature_squared(geom["bend"], q_ref)
+        K2 = curvature_squared(geom["bend"], q_ref)
         bent = float(np.sqrt(K2.max()) * lengths.max()) if K2.size else 0.0
         if bent > _STRAIGHT_TOL:
             raise ValueError("Cable3D needs a straight reference configuration (its energy EI/2 K^2 has no "
@@ -123,71 +194,15 @@ class Cable3D(KernelOption, Element):
         return geom
 
     # -- kernels ----------------------------------------------------------
-    @staticmethod
-    def _curvature_squared(rule, q):
-        a = np.einsum("epin,en->epi", rule.Ba, q)
-        b = np.einsum("epin,en->epi", rule.Bb, q)
-        p = np.einsum("...i,...i", a, a)
-        ab = np.einsum("...i,...i", a, b)
-        bb = np.einsum("...i,...i", b, b)
-        return (p * bb - ab**2) / p**2
-
     def mass_matrix(self, geom: dict) -> np.ndarray:
         return geom["M"]
 
-    def _compiled(self, geom, q, tangent):
-        """(U, f, K) from the compiled kernel; numba is imported on first use."""
-        from .cable3d_numba import cable3d_forces
-        ax, bd = geom["axial"], geom["bend"]
-        return cable3d_forces(np.ascontiguousarray(q, dtype=float), _DOF, ax.dN, ax.wdx, geom["slope_ref"],
-                              bd.dN, bd.ddN, bd.wdx, self.material.E * self.section.A,
-                              self.material.E * self.section.I3, bool(tangent))
-
     def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
-        if self._impl == "numba":
-            return self._compiled(geom, q, False)[0]
-        U, _, _ = axial_energy(geom["axial"], q, geom["slope_ref"], self.material.E * self.section.A, False)
-        rule = geom["bend"]
-        K2 = self._curvature_squared(rule, q)
-        return U + 0.5 * self.material.E * self.section.I3 * np.sum(rule.wdx * K2, axis=1)
+        return self.kernels.strain_energy(geom, q)
 
     def internal_forces(self, geom: dict, q: np.ndarray,
                         tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        if self._impl == "numba":
-            _, f, K = self._compiled(geom, q, tangent)
-            return f, (K if tangent else None)
-        _, f, K = axial_energy(geom["axial"], q, geom["slope_ref"], self.material.E * self.section.A, tangent)
-        rule = geom["bend"]
-        EI = self.material.E * self.section.I3
-        a = np.einsum("epin,en->epi", rule.Ba, q)
-        b = np.einsum("epin,en->epi", rule.Bb, q)
-        p = np.einsum("...i,...i", a, a)[..., None]
-        ab = np.einsum("...i,...i", a, b)[..., None]
-        bb = np.einsum("...i,...i", b, b)[..., None]
-        # K^2 = g / p^2 with g = |a x b|^2 = p |b|^2 - (a.b)^2
-        g = p * bb - ab**2
-        ga = 2.0 * (a * bb - ab * b)
-        gb = 2.0 * (b * p - ab * a)
-        Fa = ga / p**2 - 4.0 * g * a / p**3
-        Fb = gb / p**2
-        c = 0.5 * EI * rule.wdx[..., None]
-        f = f + np.einsum("epin,epi->en", rule.Ba, c * Fa) + np.einsum("epin,epi->en", rule.Bb, c * Fb)
-        if not tangent:
-            return f, None
-        I = np.eye(3)
-        p2, p3, p4 = (p**2)[..., None], (p**3)[..., None], (p**4)[..., None]
-        outer = lambda u, v: u[..., :, None] * v[..., None, :]   # noqa: E731
-        gaa = 2.0 * (bb[..., None] * I - outer(b, b))
-        gab = 4.0 * outer(a, b) - 2.0 * outer(b, a) - 2.0 * ab[..., None] * I
-        gbb = 2.0 * (p[..., None] * I - outer(a, a))
-        Faa = (gaa / p2 - 4.0 * (outer(ga, a) + outer(a, ga)) / p3
-               + 24.0 * g[..., None] * outer(a, a) / p4 - 4.0 * g[..., None] * I / p3)
-        Fab = gab / p2 - 4.0 * outer(a, gb) / p3
-        Fbb = gbb / p2
-        H = np.concatenate([np.concatenate([Faa, Fab], -1), np.concatenate([np.swapaxes(Fab, -1, -2), Fbb], -1)],
-                           -2) * c[..., None]
-        B = np.concatenate([rule.Ba, rule.Bb], axis=2)                     # (n_el, n_pts, 6, 12)
-        return f, K + assemble(B, H)
+        return self.kernels.internal_forces(geom, q, tangent)
 
     def shape_matrix(self, s: ArrayLike, lengths: ArrayLike) -> np.ndarray:
         N, _, _ = hermite(np.asarray(s, dtype=float), np.asarray(lengths, dtype=float))

@@ -1,20 +1,23 @@
 """Compiled Cable3D kernel: strain energy, internal forces and exact tangent in one call.
 
-The same energy as the NumPy reference of :class:`ancfdae.models.Cable3D`
+The same energy as the NumPy reference :class:`.cable3d.Cable3DReference`
 (chapter Eqs. 94-95): ``EA/2 (|r'| - |r'_ref|)^2`` at the axial points and
 ``EI/2 K^2`` with ``K^2 = g / p^2``, ``g = |a x b|^2 = p |b|^2 - (a.b)^2``,
 ``p = |a|^2`` (``a = r'``, ``b = r''``) at the bending points. One loop over
 elements calls :func:`cable3d_element`, which writes the element's row of the
 outputs; the tests hold it equal to the reference on random states.
+:class:`Cable3DCompiled` is the kernel object. Cable3D offers no fused assembly
+entry point: the beam scatters its element arrays with ``np.bincount``.
 """
 from __future__ import annotations
 
 import numpy as np
 from numba import njit
 
+from ..element import Kernel
 from .spatial_numba import axial_point, hermite_map, scatter, slope
 
-__all__ = ["cable3d_forces", "cable3d_element", "cable3d_scratch"]
+__all__ = ["Cable3DCompiled", "cable3d_forces", "cable3d_element", "cable3d_scratch"]
 
 
 @njit(cache=True, inline="always")
@@ -93,3 +96,26 @@ def cable3d_forces(q, dof, dNa, wa, slope_ref, dNb, ddNb, wb, EA, EI, tangent):
     if not tangent:
         K = K[:0]
     return U, f, K
+
+
+class Cable3DCompiled(Kernel):
+    """The compiled kernel object of Cable3D: :func:`cable3d_forces` with the arrays of the geometry."""
+
+    name = "numba"
+
+    def _forces(self, geom, q, tangent):
+        el = self.element
+        ax, bd = geom["axial"], geom["bend"]
+        return cable3d_forces(np.ascontiguousarray(q, dtype=float), ax.dof_map, ax.dN, ax.wdx, geom["slope_ref"],
+                              bd.dN, bd.ddN, bd.wdx, el.material.E * el.section.A, el.material.E * el.section.I3,
+                              bool(tangent))
+
+    def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
+        """As :meth:`.cable3d.Cable3DReference.strain_energy`, compiled."""
+        return self._forces(geom, q, False)[0]
+
+    def internal_forces(self, geom: dict, q: np.ndarray,
+                        tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """As :meth:`.cable3d.Cable3DReference.internal_forces`, compiled."""
+        _, f, K = self._forces(geom, q, tangent)
+        return f, (K if tangent else None)

@@ -46,7 +46,8 @@ class PointRule:
     s : (n_pts,) normalised coordinates; ``wdx`` : (n_el, n_pts) weights of ``dxi``;
     S, Ba, Bb : (n_el, n_pts, 3, n_edof) operators giving ``r``, ``r'`` and ``r''``;
     dN, ddN : (n_el, n_pts, 4) the Hermite functions' derivatives themselves (C-contiguous,
-    the compiled kernels' input).
+    the compiled kernels' input); dof_map : (4, 3) the element coordinate of component ``i`` of
+    Hermite vector ``k`` (the compiled kernels' scatter map).
     """
 
     def __init__(self, n_points, lengths: np.ndarray, dof_map: np.ndarray, n_edof: int):
@@ -56,6 +57,7 @@ class PointRule:
             self.s = np.asarray(n_points, dtype=float)
             w = np.zeros_like(self.s)
         self.wdx = w[None, :] * lengths[:, None] / 2.0
+        self.dof_map = dof_map
         N, dN, ddN = hermite(self.s, lengths)
         self.dN, self.ddN = np.ascontiguousarray(dN), np.ascontiguousarray(ddN)
         self.S = hermite_operator(N, dof_map, n_edof)
