@@ -57,8 +57,8 @@ def _count_child():
 
 
 def _geometry(el, beam):
-    from ancfdae.models.shear.base import _numba_geometry
-    return _numba_geometry(el.formulation, el.dim, len(el._terms), beam.geom)
+    from ancfdae.models.shear.kernels_numba import compiled_geometry
+    return compiled_geometry(el.formulation, el.dim, len(el._terms), beam.geom)
 
 
 def count_flops() -> dict:
