@@ -39,7 +39,7 @@ import numpy as np
 
 from .._validate import choice
 
-__all__ = ["Element", "Kernel", "KERNELS", "resolve_kernel"]
+__all__ = ["Element", "Kernel", "OnePassKernel", "KERNELS", "resolve_kernel"]
 
 #: Values of the ``kernel`` option.
 KERNELS = ("auto", "numba", "numpy")
@@ -91,6 +91,27 @@ class Kernel:
         one equal to.
         """
         return None
+
+
+class OnePassKernel(Kernel):
+    """A kernel whose one pass gives energy, forces and tangent: :meth:`energy_forces`.
+
+    ``strain_energy`` and ``internal_forces`` are that pass at ``order`` 0 and
+    1 or 2 (the order of the jets: 0 energy, 1 plus forces, 2 plus tangent).
+    """
+
+    def energy_forces(self, geom: Any, q: np.ndarray, order: int) -> tuple:
+        """``(U, f, K)``: energy (n_el,), forces (n_el, n_edof) and, for ``order`` 2, the tangent."""
+        raise NotImplementedError
+
+    def strain_energy(self, geom: Any, q: np.ndarray) -> np.ndarray:
+        """Strain energy of each element, shape (n_el,)."""
+        return self.energy_forces(geom, q, 0)[0]
+
+    def internal_forces(self, geom: Any, q: np.ndarray, tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """``f = dU/dq_e`` and, if ``tangent``, ``K = df/dq_e`` (else None)."""
+        _, f, K = self.energy_forces(geom, q, 2 if tangent else 1)
+        return f, (K if tangent else None)
 
 
 class Element(ABC):
@@ -268,11 +289,22 @@ class Element(ABC):
         part only (the axis translation); the rest comes from :meth:`inertia`.
         """
 
-    @abstractmethod
-    def strain_energy(self, geom: Any, q: np.ndarray) -> np.ndarray:
-        """Strain energy of each element, shape (n_el,)."""
+    def _twin(self, method: str) -> Callable:
+        """The kernel object's ``method``: the default of the kernel methods below."""
+        if not self.kernel_twins:
+            raise NotImplementedError(f"{type(self).__name__} must implement `{method}` (or list its kernel "
+                                      "implementations in `kernel_twins`).")
+        return getattr(self.kernels, method)
 
-    @abstractmethod
+    def strain_energy(self, geom: Any, q: np.ndarray) -> np.ndarray:
+        """Strain energy of each element, shape (n_el,).
+
+        This and :meth:`internal_forces` and :meth:`moment_load` call the
+        kernel object (:attr:`kernels`) of an element with ``kernel_twins``;
+        an element with one implementation overrides them.
+        """
+        return self._twin("strain_energy")(geom, q)
+
     def internal_forces(self, geom: Any, q: np.ndarray, tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """``f = dU/dq_e`` and, if ``tangent``, ``K = d f / d q_e``.
 
@@ -281,6 +313,7 @@ class Element(ABC):
         f : ndarray, shape (n_el, n_edof)
         K : ndarray, shape (n_el, n_edof, n_edof), or None
         """
+        return self._twin("internal_forces")(geom, q, tangent)
 
     @abstractmethod
     def shape_matrix(self, s: np.ndarray, lengths: np.ndarray) -> np.ndarray:
@@ -291,7 +324,6 @@ class Element(ABC):
         ndarray, shape (n_el, n_pts, dim, n_edof)
         """
 
-    @abstractmethod
     def moment_load(self, geom: Any, q: np.ndarray, s: float, moment: np.ndarray, element: int,
                     tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """Generalised force of a dead moment acting at axis point ``s`` of one element.
@@ -313,6 +345,7 @@ class Element(ABC):
             Load vector (enters the residual with a minus sign).
         dfdq : ndarray, shape (n_edof, n_edof), or None
         """
+        return self._twin("moment_load")(geom, q, s, moment, element, tangent)
 
     # -- optional: fused compiled assembly ----------------------------------
     def fused_kernel(self, geom: Any) -> tuple[Callable, tuple] | None:

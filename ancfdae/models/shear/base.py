@@ -272,13 +272,6 @@ class SQElement(Element):
     def mass_matrix(self, geom: dict) -> np.ndarray:
         return geom["M"]
 
-    def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
-        return self.kernels.strain_energy(geom, q)
-
-    def internal_forces(self, geom: dict, q: np.ndarray,
-                        tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        return self.kernels.internal_forces(geom, q, tangent)
-
     def shape_matrix(self, s: ArrayLike, lengths: ArrayLike) -> np.ndarray:
         N, _ = shapes(self.nodes, np.asarray(s, dtype=float), np.asarray(lengths, dtype=float))
         E, P, nn = N.shape
@@ -286,7 +279,3 @@ class SQElement(Element):
         for c in range(self.dim):
             S[:, :, c, :, 0, c] = N
         return S.reshape(E, P, self.dim, -1)
-
-    def moment_load(self, geom: dict, q: np.ndarray, s: float, moment: np.ndarray, element: int,
-                    tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        return self.kernels.moment_load(geom, q, s, moment, element, tangent)

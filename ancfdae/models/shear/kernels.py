@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..element import Kernel
+from ..element import OnePassKernel
 from .continuum import continuum_kernel
 from .moment import moment_load
 from .points import assemble
@@ -20,12 +20,12 @@ from .structural import structural_kernel
 __all__ = ["SQReference"]
 
 
-class SQReference(Kernel):
+class SQReference(OnePassKernel):
     """The NumPy reference of the SQ kernels: vectorised over all elements x points of a group."""
 
     name = "numpy"
 
-    def evaluate(self, geom: dict, q: np.ndarray, order: int) -> tuple:
+    def energy_forces(self, geom: dict, q: np.ndarray, order: int) -> tuple:
         """Energy (n_el,), and for ``order`` >= 1 the forces, for ``order`` 2 the tangent (else None).
 
         ``order`` is that of the jets: 0 energy, 1 plus gradient, 2 plus Hessian.
@@ -48,16 +48,6 @@ class SQReference(Kernel):
                 f = f + fg
                 K = Kg if K is None else K + Kg
         return W, f, K
-
-    def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
-        """Strain energy per element."""
-        return self.evaluate(geom, q, 0)[0]
-
-    def internal_forces(self, geom: dict, q: np.ndarray,
-                        tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        """``f = dU/dq_e`` and, if ``tangent``, ``K = df/dq_e``."""
-        _, f, K = self.evaluate(geom, q, 2 if tangent else 1)
-        return f, K
 
     def moment_load(self, geom: dict, q: np.ndarray, s: float, moment: np.ndarray, element: int,
                     tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:

@@ -32,7 +32,7 @@ import numpy as np
 from numba import njit
 
 from ..beam.assembly_numba import gather_elements, scatter
-from ..element import Kernel
+from ..element import OnePassKernel
 from .continuum import voigt
 from .continuum_numba import continuum_point
 from .moment_numba import sq_moment_load
@@ -235,7 +235,7 @@ def sq_continuum_fused(q, q_fixed, gather, vec_slot, mat_slot, tangent, r, kdata
         scatter(K, mat_slot, kdata)
 
 
-class SQCompiled(Kernel):
+class SQCompiled(OnePassKernel):
     """The compiled kernel object of SQ2D and SQ3D: :func:`sq_structural` or :func:`sq_continuum`, the
     compiled dead moment and the fused entry points."""
 
@@ -249,22 +249,12 @@ class SQCompiled(Kernel):
             arrays = geom["_numba"] = compiled_geometry(el.formulation, el.dim, len(el._terms), geom)
         return arrays
 
-    def evaluate(self, geom: dict, q: np.ndarray, order: int) -> tuple:
-        """As :meth:`.kernels.SQReference.evaluate`, compiled (the forces are zeros for ``order`` 0)."""
+    def energy_forces(self, geom: dict, q: np.ndarray, order: int) -> tuple:
+        """As :meth:`.kernels.SQReference.energy_forces`, compiled (the forces are zeros for ``order`` 0)."""
         q = np.ascontiguousarray(q, dtype=float)
         if self.element.formulation == "structural":
             return sq_structural(q, *self._arrays(geom), self.element.dim, order)
         return sq_continuum(q, *self._arrays(geom), self.element.dim, order)
-
-    def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
-        """Strain energy per element."""
-        return self.evaluate(geom, q, 0)[0]
-
-    def internal_forces(self, geom: dict, q: np.ndarray,
-                        tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        """``f = dU/dq_e`` and, if ``tangent``, ``K = df/dq_e``."""
-        _, f, K = self.evaluate(geom, q, 2 if tangent else 1)
-        return f, (K if tangent else None)
 
     def moment_load(self, geom: dict, q: np.ndarray, s: float, moment: np.ndarray, element: int,
                     tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:

@@ -277,10 +277,6 @@ class BE2D(Element):
         g, c = invariants(geom, q, order=0)
         return np.sum(geom["w"] * densities(self, g, c, geom, order=1)[0], axis=1)
 
-    def internal_forces(self, geom: dict, q: np.ndarray,
-                        tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        return self.kernels.internal_forces(geom, q, tangent)
-
     def shape_matrix(self, s: ArrayLike, lengths: ArrayLike) -> np.ndarray:
         N, _, _ = hermite(np.asarray(s, dtype=float), lengths)
         return _expand2(N)

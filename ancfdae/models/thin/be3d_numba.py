@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..element import Kernel
+from ..element import OnePassKernel
 from ..jets import scalar_numba as jet
 from .be3d_inertia_numba import be3d_inertia, be3d_kinetic_energy
 from .be3d_moment_numba import be3d_moment
@@ -221,28 +221,19 @@ def be3d_forces(q, dof, theta, dNa, wa, slope_ref, dNb, ddNb, wb, lin, L, direct
     return U, f, K
 
 
-class BE3DCompiled(Kernel):
+class BE3DCompiled(OnePassKernel):
     """The compiled kernel object of BE3D: :func:`be3d_forces`, and the compiled rotary inertia
     (:mod:`.be3d_inertia_numba`) and dead moment (:mod:`.be3d_moment_numba`)."""
 
     name = "numba"
 
-    def _forces(self, geom, q, tangent):
+    def energy_forces(self, geom: dict, q: np.ndarray, order: int) -> tuple:
+        """``(U, f, K)`` of :func:`be3d_forces` (the tangent for ``order`` 2)."""
         el = self.element
         ax, bd = geom["axial"], geom["bend"]
         return be3d_forces(np.ascontiguousarray(q, dtype=float), bd.dof_map, bd.theta, ax.dN, ax.wdx,
                            geom["slope_ref"], bd.dN, bd.ddN, bd.wdx, bd.lin, geom["L"], _directors(geom),
-                           geom["k_ref"], el.curvature_stiffness, el.EA, bool(tangent))
-
-    def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
-        """As :meth:`.be3d.BE3DReference.strain_energy`, compiled."""
-        return self._forces(geom, q, False)[0]
-
-    def internal_forces(self, geom: dict, q: np.ndarray,
-                        tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        """As :meth:`.be3d.BE3DReference.internal_forces`, compiled."""
-        _, f, K = self._forces(geom, q, tangent)
-        return f, (K if tangent else None)
+                           geom["k_ref"], el.curvature_stiffness, el.EA, order >= 2)
 
     def moment_load(self, geom: dict, q: np.ndarray, s: float, moment: np.ndarray, element: int,
                     tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:

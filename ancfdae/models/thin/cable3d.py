@@ -197,13 +197,6 @@ class Cable3D(Element):
     def mass_matrix(self, geom: dict) -> np.ndarray:
         return geom["M"]
 
-    def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
-        return self.kernels.strain_energy(geom, q)
-
-    def internal_forces(self, geom: dict, q: np.ndarray,
-                        tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        return self.kernels.internal_forces(geom, q, tangent)
-
     def shape_matrix(self, s: ArrayLike, lengths: ArrayLike) -> np.ndarray:
         N, _, _ = hermite(np.asarray(s, dtype=float), np.asarray(lengths, dtype=float))
         return hermite_operator(N, _DOF, 12)

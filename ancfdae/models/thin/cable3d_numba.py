@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..element import Kernel
+from ..element import OnePassKernel
 from .spatial_numba import axial_point, hermite_map, scatter, slope
 
 __all__ = ["Cable3DCompiled", "cable3d_forces", "cable3d_element", "cable3d_scratch"]
@@ -98,24 +98,15 @@ def cable3d_forces(q, dof, dNa, wa, slope_ref, dNb, ddNb, wb, EA, EI, tangent):
     return U, f, K
 
 
-class Cable3DCompiled(Kernel):
+class Cable3DCompiled(OnePassKernel):
     """The compiled kernel object of Cable3D: :func:`cable3d_forces` with the arrays of the geometry."""
 
     name = "numba"
 
-    def _forces(self, geom, q, tangent):
+    def energy_forces(self, geom: dict, q: np.ndarray, order: int) -> tuple:
+        """``(U, f, K)`` of :func:`cable3d_forces` (the tangent for ``order`` 2)."""
         el = self.element
         ax, bd = geom["axial"], geom["bend"]
         return cable3d_forces(np.ascontiguousarray(q, dtype=float), ax.dof_map, ax.dN, ax.wdx, geom["slope_ref"],
                               bd.dN, bd.ddN, bd.wdx, el.material.E * el.section.A, el.material.E * el.section.I3,
-                              bool(tangent))
-
-    def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
-        """As :meth:`.cable3d.Cable3DReference.strain_energy`, compiled."""
-        return self._forces(geom, q, False)[0]
-
-    def internal_forces(self, geom: dict, q: np.ndarray,
-                        tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        """As :meth:`.cable3d.Cable3DReference.internal_forces`, compiled."""
-        _, f, K = self._forces(geom, q, tangent)
-        return f, (K if tangent else None)
+                              order >= 2)
