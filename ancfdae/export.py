@@ -48,11 +48,11 @@ def beam_of(result: Result) -> Beam:
         If the result carries no beam description (e.g. a model other than
         a Beam).
     """
-    from .models._describe import rebuild
+    from .models import Beam
     if not result.model or "element" not in result.model:
         raise ValueError("`result` carries no beam description (result.model is empty: the model was not a "
                          "Beam); pass the beam explicitly.")
-    beam = rebuild(result.model)
+    beam = Beam.from_description(result.model)
     if beam.n_dof != result.q.shape[1]:
         raise ValueError(f"the beam rebuilt from `result` has {beam.n_dof} coordinates, the result "
                          f"{result.q.shape[1]}.")

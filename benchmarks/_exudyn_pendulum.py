@@ -8,8 +8,8 @@ from __future__ import annotations
 import numpy as np
 
 from ancfdae._validate import choice, positive, positive_int
-from ancfdae.models._quadrature import gauss_for_order
-from ancfdae.models._shapes import hermite
+from ancfdae._quadrature import gauss_for_order
+from ancfdae.models.shapes import hermite
 
 from ._exudyn_base import _base_settings, _exu, _fix, _ground_marker, _ii, _require, timed_solves
 

@@ -39,7 +39,8 @@ def _model(formulation, n_el, nodes=3):
 
 def _count_child():
     """In a NUMBA_DISABLE_JIT=1 process: flops of one element per formulation, as JSON on stdout."""
-    from ancfdae.models import _vector_jet_numba, _sq_numba
+    from ancfdae.models.jets import vector_numba as _vector_jet_numba
+    from ancfdae.models.shear import kernels_numba as _sq_numba
     from . import flop_counter as fc
     fc.patch_numpy(_sq_numba, _vector_jet_numba)
     out = {}
@@ -56,8 +57,8 @@ def _count_child():
 
 
 def _geometry(el, beam):
-    from ancfdae.models._sq_common import _numba_geometry
-    return _numba_geometry(el.formulation, el.dim, len(el._terms), beam.geom)
+    from ancfdae.models.shear.kernels_numba import compiled_geometry
+    return compiled_geometry(el.formulation, el.dim, len(el._terms), beam.geom)
 
 
 def count_flops() -> dict:

@@ -4,7 +4,6 @@ import pytest
 
 from ancfdae import Material, RectangularSection
 from ancfdae.models import BE2D, Beam
-from ancfdae.models import _kernel_option
 
 
 def _states(formulation, kernel, n_el=5, seed=0):
@@ -34,14 +33,14 @@ def test_numba_kernel_equals_numpy_kernel(formulation):
     assert scale_f > 0
 
 
-def test_auto_kernel_follows_numba_availability(monkeypatch):
-    monkeypatch.setattr(_kernel_option, "numba_available", lambda: False)
+def test_auto_kernel_is_the_compiled_one_and_the_option_selects_once():
+    # Catches "auto" falling back to NumPy (numba is a dependency: there is nothing to fall back from), and a
+    # kernel object that is not rebuilt when the option changes on a built element.
     el = BE2D(Material(2.1e11, 0.3, 7800.0), RectangularSection(0.1))
-    assert el.kernel == "auto" and el.kernel_in_use == "numpy"
-    with pytest.raises(ImportError, match="kernel.*numba"):
-        BE2D(Material(2.1e11, 0.3, 7800.0), RectangularSection(0.1), kernel="numba")
-    monkeypatch.setattr(_kernel_option, "numba_available", lambda: True)
-    assert BE2D(Material(2.1e11, 0.3, 7800.0), RectangularSection(0.1)).kernel_in_use == "numba"
+    assert el.kernel == "auto" and el.kernel_in_use == "numba" and "kernel='auto'" in repr(el)
+    compiled = el.kernels
+    el.kernel = "numpy"
+    assert el.kernel_in_use == "numpy" and el.kernels is not compiled and el.fused_kernel({}) is None
 
 
 def test_unknown_kernel_is_rejected():

@@ -4,7 +4,7 @@ import pytest
 
 from ancfdae import Material, PointForce, PointMoment, RectangularSection, solve_static
 from ancfdae.models import BE2D, BE3D, Beam
-from ancfdae.models._be3d_kinematics import spin_coefficients
+from ancfdae.models.thin.be3d_kinematics import spin_coefficients
 from test_be2d import TABLE2_RTOL
 from conftest import fd_gradient, rel_err
 
@@ -42,7 +42,7 @@ def spin_velocity(beam, q, omega):
     V[:, :3] = np.cross(omega, Q[:, :3])
     V[:, 3:6] = np.cross(omega, Q[:, 3:6])
     a = Q[:, 3:6]
-    g = np.stack([j.v for j in spin_coefficients(a, beam.geom["directors"], False)], axis=-1)
+    g = np.stack([j.v for j in spin_coefficients(a, beam.geom["directors"], 1)], axis=-1)
     V[:, 6] = (a / np.linalg.norm(a, axis=1)[:, None]) @ omega - np.einsum("ni,ni->n", g, V[:, 3:6])
     return V.reshape(-1)[beam.free]
 
@@ -99,7 +99,7 @@ def test_inertia_force_follows_lagrange_equations(steel):
     lagrange = ddt - fd_gradient(lambda z: T(z, v), q.ravel())
     f, dq, dv, da = el.inertia(beam.geom, q, v, a)
     assert rel_err(f.ravel(), lagrange) < 1e-6
-    assert np.allclose(el.inertia(beam.geom, q, v, a, jacobian=False)[0], f)
+    assert np.allclose(el.inertia(beam.geom, q, v, a, tangent=False)[0], f)
     assert el.kinetic_energy_extra(beam.geom, q, v).sum() == pytest.approx(0.5 * np.einsum("ei,eij,ej", v, da, v),
                                                                          rel=1e-13)
     # uniform spin of the straight reference beam: T = rho J L omega^2 / 2
@@ -344,12 +344,12 @@ def test_cantilever_study_has_the_be3d_and_cable3d_rows():
 
 def test_residual_path_equals_the_jets():
     """The written-out chain rule of the residual path equals the jets' values and gradients."""
-    from ancfdae.models._be3d_kinematics import curvature_energy, curvatures, spin_gradient
+    from ancfdae.models.thin.be3d_kinematics import curvature_energy, curvatures, spin_gradient
     rng = np.random.default_rng(9)
     a, b, d, dp, k_ref = rng.standard_normal((5, 4, 3, 3))
     th, dth = rng.standard_normal((2, 4, 3))
     D = np.array([1.3, 0.7, 2.1])
-    k = curvatures(a, b, th, dth, d, dp, second=False)
+    k = curvatures(a, b, th, dth, d, dp, order=1)
     W, grad = curvature_energy(a, b, th, dth, d, dp, k_ref, D)
     assert np.allclose(W, 0.5 * sum(D[i] * (k[i].v - k_ref[..., i]) ** 2 for i in range(3)), rtol=1e-13)
     assert rel_err(grad, sum(D[i] * (k[i].v - k_ref[..., i])[..., None] * k[i].g for i in range(3))) < 1e-13

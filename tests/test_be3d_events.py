@@ -92,3 +92,21 @@ def test_ida_restarts_do_not_grow_memory():
     res = simulate(b3(8), (0, 0.2), "ida", rtol=1e-6, max_steps=300, t_eval=[0.0])
     assert res.stats["restarts"] == 300 and res.options["linsolver"] == "band"
     assert _rss_mb() - r0 < 20.0
+
+
+def test_reference_directors_reach_prepare_as_an_argument():
+    """The directors go from ``reference_state`` to ``prepare`` as an argument, nothing is left on the element.
+
+    Catches a hand-over through element state (a geometry prepared with the directors of the previous
+    beam, or with the fallback instead of the given ``director``) and a wrong-shaped ``directors``
+    accepted silently.
+    """
+    el = BE3D(SOFT, SEC, director=(0.0, 1.0, 1.0))
+    for n in (2, 3):   # one element, two meshes: each geometry has its own mesh's directors
+        beam = Beam(el, n, 1.0, direction=(0.6, 0.8, 0.0))
+        ref = el.reference_state(beam.points, beam.frames)["directors"]
+        assert ref.shape == (n + 1, 3)
+        np.testing.assert_array_equal(beam.geom["directors"], ref)
+        assert not beam.geom["directors"].flags.writeable
+    with pytest.raises(ValueError, match="directors.*shape"):
+        el.prepare(beam.q_ref[beam.edofs], beam.lengths, directors=np.ones((2, 3)))

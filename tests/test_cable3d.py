@@ -54,8 +54,8 @@ def test_forces_tangent_and_moment_match_finite_differences(steel):
 
 def slope_operator(beam, s, e):
     """r'(s) = Sx q_e for element e of a Cable3D beam."""
-    from ancfdae.models._shapes import hermite
-    from ancfdae.models._thin import hermite_operator
+    from ancfdae.models.shapes import hermite
+    from ancfdae.models.thin.spatial import hermite_operator
     _, dN, _ = hermite(np.array([s]), beam.lengths[[e]])
     return hermite_operator(dN, np.arange(12).reshape(4, 3), 12)[0, 0]
 

@@ -100,6 +100,26 @@ def test_dof_labels_name_node_and_coordinate():
     assert "theta" in coord and "x'" in coord
 
 
+def test_a_users_element_rebuilds_from_the_file_by_its_name(tmp_path):
+    # Catches a hard-coded list of the built-in elements in the rebuild (a user's element could not be
+    # read back) and a registry that lets two classes claim one name.
+    from ancfdae.models import Element
+
+    class StiffBE2D(BE2D):
+        name = "StiffBE2D"
+
+    beam = _beam(StiffBE2D, bending_points=4)
+    res = simulate(beam, (0, 0.01), "lobatto3", h=0.005)
+    back = Beam.from_description(Result.load(res.save(tmp_path / "r.nc")).model)
+    assert type(back.element) is StiffBE2D and back.element.bending_points == 4
+    np.testing.assert_array_equal(back.q_ref, beam.q_ref)
+    assert Element.by_name("StiffBE2D") is StiffBE2D
+    with pytest.raises(TypeError, match="StiffBE2D"):
+        type("Impostor", (BE2D,), {"name": "StiffBE2D"})
+    with pytest.raises(ValueError, match="element type must be one of .*got 'Nonesuch'"):
+        Element.by_name("Nonesuch")
+
+
 def test_failed_result_round_trip(tmp_path):
     res = simulate(SpringChain(2), (0, 1), "newmark", h=0.05, monitors=[EnergyMonitor()],
                    newton={"max_iter": 1, "tol": 1e-14, "atol": 0.0, "jacobian": "full"})

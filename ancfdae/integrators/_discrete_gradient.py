@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ancfdae.models._quadrature import gauss
+from ancfdae._quadrature import gauss
 
 __all__ = ["AVFGradient", "GonzalezGradient"]
 

@@ -1,0 +1,82 @@
+"""Compiled gather and scatter of the fused assembly (needs numba).
+
+An element with a compiled kernel provides a *fused* entry point that takes the
+free coordinates and returns assembled arrays in one compiled call::
+
+    fused(q, q_fixed, gather, vec_slot, mat_slot, tangent, r, kdata, *element_args)
+
+It gathers the element coordinates with :func:`gather_elements`, runs the
+element kernel (a loop over elements returning ``f`` of shape (n_el, n_edof)
+and, if ``tangent``, ``K`` of shape (n_el, n_edof, n_edof)), and sums them with
+:func:`scatter` into ``r`` (length ``n_dof + 1``) and ``kdata`` (length
+``nnz + 1``): the CSR data array of the beam's fixed pattern. The extra last
+bin receives the entries of fixed coordinates and is dropped. Entries are
+added in element order starting from zero, which is exactly what
+``np.bincount`` does in the NumPy assembly, so both give the same bits for the
+same element arrays. See :func:`ancfdae.models.thin.be2d_numba.be2d_fused` for the template.
+
+numba's on-disk cache is keyed on the source file of the cached function only, and a fused entry
+point holds a compiled copy of the kernel it calls: after editing a kernel in another file, delete the
+``*.nbi``/``*.nbc`` files in ``ancfdae/models/__pycache__`` (a fresh install has no stale cache).
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+__all__ = ["gather_elements", "scatter", "finish_residual"]
+
+
+@njit(cache=True)
+def gather_elements(q, q_fixed, gather):
+    """Element coordinates ``(n_el, n_edof)``: ``gather[e, k] < q.size`` indexes ``q``, the rest ``q_fixed``."""
+    n_el, nd = gather.shape
+    nq = q.size
+    qe = np.empty((n_el, nd))
+    for e in range(n_el):
+        for k in range(nd):
+            g = gather[e, k]
+            qe[e, k] = q[g] if g < nq else q_fixed[g - nq]
+    return qe
+
+
+@njit(cache=True)
+def scatter(values, slot, out):
+    """``out[:] = 0``, then ``out[slot[k]] += values.flat[k]`` in order (``np.bincount`` semantics)."""
+    out[:] = 0.0
+    flat = values.reshape(-1)
+    for k in range(slot.size):
+        out[slot[k]] += flat[k]
+
+
+@njit(cache=True)
+def finish_residual(r, m_data, indptr, indices, a, lam, f_ext):
+    """``r[i] = (r[i] + (M a)[i]) - lam * f_ext[i]`` for ``i < n``, with M in CSR form.
+
+    Rounds as ``f + M @ a - lam * f_ext`` does with scipy (row sums from zero in
+    pattern order; no fused multiply-add).
+    """
+    n = indptr.size - 1
+    for i in range(n):
+        s = 0.0
+        for jj in range(indptr[i], indptr[i + 1]):
+            s += m_data[jj] * a[indices[jj]]
+        r[i] = (r[i] + s) - lam * f_ext[i]
+
+
+@njit(cache=True)
+def finish_stages(F, m_data, indptr, indices, A, lam, f_ext, R):
+    """``R[i, k] = (F[k, i] + (M A)[i, k]) - lam * f_ext[i, k]`` for the stages ``k``.
+
+    ``F`` (m, n + 1): the stages' assembled forces (last column: fixed bin);
+    ``A``, ``f_ext``, ``R`` (n, m). Rounds as ``F.T + M @ A - lam * f_ext`` with
+    scipy (its CSR times dense matrix accumulates row by row in pattern order).
+    """
+    n = indptr.size - 1
+    m = A.shape[1]
+    for i in range(n):
+        for k in range(m):
+            s = 0.0
+            for jj in range(indptr[i], indptr[i + 1]):
+                s += m_data[jj] * A[indices[jj], k]
+            R[i, k] = (F[k, i] + s) - lam * f_ext[i, k]

@@ -1,0 +1,6 @@
+"""The thin (Bernoulli-Euler) ANCF beam elements of chapter Sect. 3: BE2D, Cable3D, BE3D."""
+from .be2d import BE2D
+from .be3d import BE3D
+from .cable3d import Cable3D
+
+__all__ = ["BE2D", "BE3D", "Cable3D"]
