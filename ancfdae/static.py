@@ -9,9 +9,10 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.linalg import LinAlgWarning
 
-from ._validate import positive_int
-from .integrators._newton import NewtonOptions, NewtonSolver, NewtonStats
-from ._scale import ROUNDOFF, force_scale
+from . import _validate as validate
+from ._scale import absolute_tolerance
+from .integrators._newton import NewtonSolver
+from .integrators._newton_records import RENAMED_ATOL, NewtonOptions, NewtonStats
 from .problem import Model, capabilities
 
 __all__ = ["solve_static", "StaticResult"]
@@ -56,8 +57,9 @@ class StaticResult:
         return self.status == "converged"
 
 
+@validate.renamed("atol", "residual_atol", RENAMED_ATOL)
 def solve_static(model: Model, load_steps: int = 10, *, t: float = 0.0, q0: ArrayLike | None = None, tol: float = 1e-8,
-                 atol: float | None = None, max_iter: int = 25, jacobian: str = "full") -> StaticResult:
+                 residual_atol: float | None = None, max_iter: int = 25, jacobian: str = "full") -> StaticResult:
     """Solve ``r(t, q, 0, 0) = 0`` with the loads applied in uniform steps.
 
     Load step ``i`` solves for the load factor ``lambda_i = i / load_steps``,
@@ -79,15 +81,18 @@ def solve_static(model: Model, load_steps: int = 10, *, t: float = 0.0, q0: Arra
     tol : float
         Relative tolerance: a load step converges when ``max|r| <= tol *
         max|r_0|``, ``r_0`` the residual at its start (the chapter's test).
-    atol : float, optional
-        Absolute floor in the residual's units. By default it is derived from
-        round-off, ``ROUNDOFF * eps * force_scale(model, t, q0)`` at full load
-        (see :func:`ancfdae._scale.force_scale`), never a fixed number of newtons: a 1e-10 N
-        tip load on a micro-fibre is then solved, not declared converged
+    residual_atol : float, optional
+        Absolute tolerance on the residual, in its units (formerly ``atol``). By
+        default it is derived from round-off, ``ATOL_ROUNDOFF * eps *
+        force_scale(model, t, q0)`` at full load (see
+        :func:`ancfdae._scale.absolute_tolerance`), never a fixed number of newtons:
+        a 1e-10 N tip load on a micro-fibre is then solved, not declared converged
         before the first iteration.
-    max_iter, jacobian
-        Newton options, see :class:`ancfdae.integrators._newton.NewtonOptions`
-        (``jacobian="full"`` is the chapter's classical Newton).
+    max_iter : int
+        Newton iterations allowed per load step.
+    jacobian : {"full", "modified"}
+        Newton's refresh policy (:class:`ancfdae.integrators.NewtonOptions`);
+        ``"full"`` is the chapter's classical Newton.
 
     Returns
     -------
@@ -96,7 +101,7 @@ def solve_static(model: Model, load_steps: int = 10, *, t: float = 0.0, q0: Arra
         and a message naming the load step and its residual; ``q`` is then the
         last converged step's solution.
     """
-    load_steps = positive_int("load_steps", load_steps)
+    load_steps = validate.positive_int("load_steps", load_steps)
     if load_steps > 1 and not hasattr(model, "load_factor"):
         raise ValueError("`model` must have a `load_factor` attribute for load stepping; "
                          f"use load_steps=1 with {type(model).__name__}.")
@@ -106,9 +111,9 @@ def solve_static(model: Model, load_steps: int = 10, *, t: float = 0.0, q0: Arra
     q = model.initial_state()[0].copy() if q0 is None else np.array(q0, dtype=float)
     if q.shape != (model.n_dof,):
         raise ValueError(f"`q0` must have shape ({model.n_dof},), got {q.shape}.")
-    if atol is None:
-        atol = ROUNDOFF * np.finfo(float).eps * force_scale(model, t, q)
-    solver = NewtonSolver(NewtonOptions(tol=tol, atol=atol, max_iter=max_iter, jacobian=jacobian))
+    if residual_atol is None:
+        residual_atol = absolute_tolerance(model, t, q)
+    solver = NewtonSolver(NewtonOptions(tol=tol, residual_atol=residual_atol, max_iter=max_iter, jacobian=jacobian))
     z = np.zeros(model.n_dof)
     saved = getattr(model, "load_factor", None)
     steps, status, message = [], "converged", f"converged in {load_steps} load steps"
@@ -128,7 +133,7 @@ def solve_static(model: Model, load_steps: int = 10, *, t: float = 0.0, q0: Arra
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always", LinAlgWarning)
                 out = solver.solve(lambda x, m=m: m.residual(t, x, z, z), lambda x, m=m: m.jacobian(t, x, z, z).K,
-                                   q, residual_jacobian=fused)
+                                   q, residual_atol=residual_atol, residual_jacobian=fused)
             singular = [w for w in caught if issubclass(w.category, LinAlgWarning)]
             for w in caught:
                 if w not in singular or out.converged:
