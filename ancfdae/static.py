@@ -12,7 +12,7 @@ from scipy.linalg import LinAlgWarning
 from . import _validate as validate
 from ._scale import absolute_tolerance
 from .integrators._newton import NewtonSolver
-from .integrators._newton_records import RENAMED_ATOL, NewtonOptions, NewtonStats
+from .integrators._newton_records import RENAMED_ATOL, NewtonOptions
 from .problem import Model, capabilities
 
 __all__ = ["solve_static", "StaticResult"]
@@ -26,17 +26,19 @@ class StaticResult:
     ----------
     q : ndarray
         Coordinates of the last converged load step (the solution when
-        ``status == "converged"``; never an unconverged iterate).
-    status : {"converged", "failed"}
+        ``status == "success"``; never an unconverged iterate).
+    status : {"success", "failed"}
+        As :attr:`ancfdae.Result.status`: "success" when every load step converged.
     message : str
         Says which load step failed and with which residual, if one did.
     iterations : int
         Newton iterations over all load steps.
     steps : list of dict
         Per load step: ``load_factor``, ``iterations``, ``residual``, ``converged``, ``q``.
-    stats : NewtonStats
-    cpu_time : float
-        Process time of the solve in seconds.
+    stats : dict
+        Work counters under the names of :attr:`ancfdae.Result.stats`: ``newton_iterations``,
+        ``newton_solves``, ``failed_solves``, ``retries``, ``residual_evals``, ``jacobian_evals``,
+        ``factorizations``, and ``cpu_time`` (process time of the solve in seconds).
     state : dict
         The model's event state after the last converged load step (models with the
         ``"step_events"`` capability, e.g. BE3D's ``{"directors": ...}``); empty otherwise.
@@ -47,14 +49,13 @@ class StaticResult:
     message: str
     iterations: int
     steps: list = field(default_factory=list)
-    stats: NewtonStats = field(default_factory=NewtonStats)
-    cpu_time: float = 0.0
+    stats: dict = field(default_factory=dict)
     state: dict = field(default_factory=dict)
 
     @property
     def success(self) -> bool:
         """True when every load step converged."""
-        return self.status == "converged"
+        return self.status == "success"
 
 
 @validate.renamed("atol", "residual_atol", RENAMED_ATOL)
@@ -116,7 +117,7 @@ def solve_static(model: Model, load_steps: int = 10, *, t: float = 0.0, q0: Arra
     solver = NewtonSolver(NewtonOptions(tol=tol, residual_atol=residual_atol, max_iter=max_iter, jacobian=jacobian))
     z = np.zeros(model.n_dof)
     saved = getattr(model, "load_factor", None)
-    steps, status, message = [], "converged", f"converged in {load_steps} load steps"
+    steps, status, message = [], "success", f"converged in {load_steps} load steps"
     start = _time.process_time()
     try:
         for i in range(1, load_steps + 1):
@@ -157,6 +158,7 @@ def solve_static(model: Model, load_steps: int = 10, *, t: float = 0.0, q0: Arra
     finally:
         if saved is not None:
             model.load_factor = saved
+    stats = solver.stats.as_stats()
+    stats["cpu_time"] = _time.process_time() - start
     return StaticResult(q=q, status=status, message=message,
-                        iterations=sum(s["iterations"] for s in steps), steps=steps,
-                        stats=solver.stats, cpu_time=_time.process_time() - start, state=state)
+                        iterations=sum(s["iterations"] for s in steps), steps=steps, stats=stats, state=state)
