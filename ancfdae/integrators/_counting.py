@@ -6,8 +6,11 @@ proxy declares the wrapped model's capabilities deliberately (an instance attrib
 :func:`ancfdae.problem.capabilities` reads without ``__getattr__``), so every fast path stays
 available, and it forwards everything it does not count.
 
-Cost: a counted call is one Python call more than the model's own (an attribute increment and a
-forward; measured with ``python -m benchmarks.counting_overhead`` against the 8-element BE2D residual).
+Cost: a counted call is one Python call more than the model's own, as the steppers' former
+hand-counting methods were. Measured with ``python -m benchmarks.counting_overhead`` (process-CPU
+medians, 3 runs on a shared 2-core machine): +0.13 to +0.29 us per call over a direct call of a model
+that does no work, against +0.08 to +0.15 us for the former hand-counting method; the residual of an
+8-element BE2D beam takes 8 to 14 us.
 """
 from __future__ import annotations
 
