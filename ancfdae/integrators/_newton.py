@@ -26,8 +26,6 @@ import numpy as np
 from numpy.typing import ArrayLike
 from numba import njit
 
-from ancfdae import _validate as validate
-
 from ._linsolve import factorize
 from ._newton_records import NewtonOptions, NewtonOutcome, NewtonStats
 
@@ -194,7 +192,9 @@ class NewtonSolver:
         """
         if residual_atol is None:
             residual_atol = self.options.residual_atol or 0.0
-        keep_max = validate.choice("floor_update", floor_update, ("max", "replace")) == "max"
+        keep_max = floor_update == "max"
+        if not keep_max and floor_update != "replace":
+            raise ValueError(f"`floor_update` must be one of ['max', 'replace'], got {floor_update!r}.")
         fused = residual_jacobian if self.options.jacobian == "full" else None
         x0 = np.array(x0, dtype=float, copy=True).ravel()
         self.stats.solves += 1

@@ -156,23 +156,23 @@ class EnergyMomentum(NewtonStepper):
         self._bind(model)
 
     def _bind(self, model):
-        """Mass matrix and its factorisation of ``model`` (a plain model, not the counting proxy)."""
+        """Mass matrix, its factorisation and the discrete gradient of ``model`` (a plain model).
+
+        The discrete gradient evaluates ``self.model``, the counting proxy (its ``potential*`` calls
+        show in the stats), which then wraps ``model``.
+        """
         self._model_bound = model
         self._M = sp.csr_matrix(model.mass(model.initial_state()[0]))
         self._Mlu = spla.splu(sp.csc_matrix(self._M))
-
-    def _gradient(self):
-        """The discrete gradient, evaluating the counted model (``potential*`` calls show in the stats)."""
-        degree = getattr(self.model, "potential_degree", None)
-        return (AVFGradient(self.model, degree) if self.discrete_gradient == "avf"
-                else GonzalezGradient(self.model, self._M, rotations=self.angular_momentum))
+        degree = getattr(model, "potential_degree", None)
+        self._dg = (AVFGradient(self.model, degree) if self.discrete_gradient == "avf"
+                    else GonzalezGradient(self.model, self._M, rotations=self.angular_momentum))
 
     def _setup(self):
         """The driver may hand another model instance: bind it; check the residual split."""
         super()._setup()
         if self.model.wrapped is not self._model_bound:
             self._bind(self.model.wrapped)
-        self._dg = self._gradient()
         self._check_split(self.t, self.q, self.v)
 
     def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model) -> None:
@@ -190,7 +190,6 @@ class EnergyMomentum(NewtonStepper):
         super().restart(t, q, v, a, model)
         if self.model.wrapped is not self._model_bound:
             self._bind(self.model.wrapped)
-            self._dg = self._gradient()
 
     def _check_split(self, t, q, v):
         """The scheme integrates ``M a + grad P - f_nc``; refuse a model whose residual has more
