@@ -82,14 +82,8 @@ def absolute_tolerance(model, t: float, q: np.ndarray, v: np.ndarray | None = No
 
     Parameters
     ----------
-    model : Model
-        The equations of motion.
-    t : float
-        Time.
-    q : ndarray, shape (n_dof,)
-        Coordinates.
-    v, a : ndarray, shape (n_dof,), optional
-        Velocities and accelerations (zero by default: statics).
+    model, t, q, v, a
+        As for :func:`force_scale`.
 
     Returns
     -------

@@ -176,16 +176,12 @@ class EnergyMomentum(NewtonStepper):
         self._check_split(self.t, self.q, self.v)
 
     def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model) -> None:
-        """Carry on from a state a model event changed (grid and Newton matrix kept).
+        """Carry on from a state a model event changed (grid and Newton matrix kept; a new model rebound).
 
         Parameters
         ----------
-        t : float
-            Time of the event.
-        q, v, a : ndarray
-            The changed state.
-        model : Model
-            The model bound to the event's new state.
+        t, q, v, a, model
+            As for :meth:`~ancfdae.integrators.Integrator.restart`.
         """
         super().restart(t, q, v, a, model)
         if self.model.wrapped is not self._model_bound:

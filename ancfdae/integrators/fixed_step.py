@@ -87,12 +87,8 @@ class FixedStepIntegrator(Integrator):
 
         Parameters
         ----------
-        t : float
-            Time of the event.
-        q, v, a : ndarray
-            The changed state.
-        model : Model
-            The model bound to the event's new state.
+        t, q, v, a, model
+            As for :meth:`Integrator.restart`.
         """
         previous = self.previous
         super().restart(t, q, v, a, model)

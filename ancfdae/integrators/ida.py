@@ -274,12 +274,8 @@ class IDA(Integrator):
 
         Parameters
         ----------
-        t : float
-            Time of the event.
-        q, v, a : ndarray
-            The changed state (``a`` recomputed consistently by the driver).
-        model : Model
-            The model bound to the event's new state.
+        t, q, v, a, model
+            As for :meth:`~ancfdae.integrators.Integrator.restart` (``a`` consistent: ``consistent_restart``).
         """
         super().restart(t, q, v, a, model)
         self._solver.init_step(float(t), *self._join(q, v, a))

@@ -323,45 +323,29 @@ class LobattoIIIA(NewtonStepper):
                            quadrature=quad)
 
 
-class Lobatto3(LobattoIIIA):
+class _FixedStages(LobattoIIIA):
+    """Lobatto IIIA with the class's number of stages (``STAGES``): a key of ``ancfdae.METHODS``."""
+
+    STAGES = 3
+
+    def __init__(self, model: Model, h: float, *, newton: NewtonOptions | dict | None = None,
+                 predictor: str = "constant") -> None:
+        super().__init__(model, h, self.STAGES, newton=newton, predictor=predictor)
+
+
+class Lobatto3(_FixedStages):
     """Lobatto IIIA with 3 stages (order 4; the chapter's integrator), ``METHODS["lobatto3"]``.
 
-    Parameters
-    ----------
-    model : Model
-        The equations of motion.
-    h : float
-        Step size.
-    newton : NewtonOptions or dict, optional
-        Default: modified Newton, relative tolerance 1e-8 (chapter Sect. 5.2).
-    predictor : {"constant", "extrapolate"}
-        Initial guess of the stage accelerations (see :class:`LobattoIIIA`).
+    Takes the arguments of :class:`LobattoIIIA` but ``stages``.
     """
 
-    name = "lobatto3"
-
-    def __init__(self, model: Model, h: float, *, newton: NewtonOptions | dict | None = None,
-                 predictor: str = "constant") -> None:
-        super().__init__(model, h, 3, newton=newton, predictor=predictor)
+    name, STAGES = "lobatto3", 3
 
 
-class Lobatto2(LobattoIIIA):
+class Lobatto2(_FixedStages):
     """Lobatto IIIA with 2 stages (trapezoidal rule, order 2), ``METHODS["lobatto2"]``.
 
-    Parameters
-    ----------
-    model : Model
-        The equations of motion.
-    h : float
-        Step size.
-    newton : NewtonOptions or dict, optional
-        Default: modified Newton, relative tolerance 1e-8.
-    predictor : {"constant", "extrapolate"}
-        Initial guess of the stage accelerations (see :class:`LobattoIIIA`).
+    Takes the arguments of :class:`LobattoIIIA` but ``stages``.
     """
 
-    name = "lobatto2"
-
-    def __init__(self, model: Model, h: float, *, newton: NewtonOptions | dict | None = None,
-                 predictor: str = "constant") -> None:
-        super().__init__(model, h, 2, newton=newton, predictor=predictor)
+    name, STAGES = "lobatto2", 2
