@@ -1,6 +1,8 @@
 """Input checks shared by the package: each raises with the argument, the rule and the value."""
 from __future__ import annotations
 
+import functools
+import inspect
 import numbers
 
 import numpy as np
@@ -57,3 +59,25 @@ def check_shape(name: str, value, shape: tuple, what: str = "") -> None:
     if got != shape:
         why = f" ({what})" if what else ""
         raise ValueError(f"`{name}` must have shape {shape}{why}, got {got}.")
+
+
+def renamed(old: str, new: str, why: str):
+    """Decorator: a call with the keyword ``old`` raises a TypeError naming ``new`` and ``why``.
+
+    On a class it wraps ``__init__`` (put it above ``@dataclass``). The signature shown to users is
+    the new one; the old keyword only gets the explanation instead of Python's bare "unexpected
+    keyword argument".
+    """
+    def wrap(obj):
+        func = obj.__init__ if inspect.isclass(obj) else obj
+
+        @functools.wraps(func)
+        def call(*args, **kwargs):
+            if old in kwargs:
+                raise TypeError(f"`{old}` was renamed `{new}` ({why}); got {old}={kwargs[old]!r}.")
+            return func(*args, **kwargs)
+        if inspect.isclass(obj):
+            obj.__init__ = call
+            return obj
+        return call
+    return wrap

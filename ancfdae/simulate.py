@@ -5,7 +5,9 @@ the integrator, and a :class:`~ancfdae.result.Result` that reports failure in
 its ``status`` instead of raising. Bad arguments still raise (ValueError /
 TypeError naming the argument). The run itself is the one driver loop of
 :mod:`ancfdae.integrators.driver`; integrators are steppers
-(:mod:`ancfdae.integrators.protocol`), ours and a user's own alike.
+(:mod:`ancfdae.integrators.protocol`), ours and a user's own alike, and
+``simulate(model, t_span, method=stepper)`` returns the same Result as
+``stepper.run(t_span)``.
 """
 from __future__ import annotations
 
@@ -17,37 +19,15 @@ from numpy.typing import ArrayLike
 
 from ancfdae.integrators.driver import integrate
 from ancfdae.integrators.energy_momentum import EnergyMomentum
-from ancfdae.integrators._newton import NewtonOptions
 from ancfdae.integrators.ida import IDA
-from ancfdae.integrators.lobatto import LobattoIIIA
+from ancfdae.integrators.integrator import Integrator
+from ancfdae.integrators.lobatto import Lobatto2, Lobatto3
 from ancfdae.integrators.newmark import GeneralizedAlpha, HHTAlpha, Newmark
-from ancfdae._resultfile import describe_model
-from ancfdae.integrators.protocol import Integrator
 from ancfdae.monitors import Monitor
 from ancfdae.problem import Model
 from ancfdae.result import Result
 
 __all__ = ["simulate", "METHODS"]
-
-
-class Lobatto3(LobattoIIIA):
-    """Lobatto IIIA with 3 stages (order 4; the chapter's integrator)."""
-
-    name = "lobatto3"
-
-    def __init__(self, model: Model, h: float, *, newton: NewtonOptions | dict | None = None,
-                 predictor: str = "constant") -> None:
-        super().__init__(model, h, 3, newton=newton, predictor=predictor)
-
-
-class Lobatto2(LobattoIIIA):
-    """Lobatto IIIA with 2 stages (trapezoidal rule, order 2)."""
-
-    name = "lobatto2"
-
-    def __init__(self, model: Model, h: float, *, newton: NewtonOptions | dict | None = None,
-                 predictor: str = "constant") -> None:
-        super().__init__(model, h, 2, newton=newton, predictor=predictor)
 
 
 #: name -> integrator class; fixed-step classes take ``h``, IDA does not.
@@ -119,7 +99,7 @@ def simulate(model: Model, t_span: tuple[float, float], method: str | type[Integ
         ``"generalized-alpha"``, ``"ida"``, ``"energy-momentum"`` (constant
         mass matrix and the ``"potential"`` capability: energy and momenta
         kept exactly) -- or a class written against
-        :class:`ancfdae.integrators.protocol.Integrator` (built with
+        :class:`ancfdae.integrators.Integrator` (built with
         ``cls(model, h, **options)`` or ``cls(model, **options)``), or a
         constructed instance (then no ``h`` or options here).
     h : float
@@ -148,7 +128,7 @@ def simulate(model: Model, t_span: tuple[float, float], method: str | type[Integ
     progress : bool
         Show a tqdm progress bar of the simulated time (steps/s, ETA).
     **options
-        Passed to the integrator: ``newton=NewtonOptions(...)`` (fixed-step),
+        Passed to the integrator: ``newton=NewtonOptions(...)`` (the Newton steppers),
         ``beta, gamma`` (newmark), ``alpha`` (hht), ``rho_inf``
         (generalized-alpha), ``predictor`` (lobatto), ``rtol, atol,
         max_order, linsolver, ...`` (ida).
@@ -162,8 +142,5 @@ def simulate(model: Model, t_span: tuple[float, float], method: str | type[Integ
         the failure.
     """
     stepper = _build(model, method, h, options)
-    result = integrate(stepper, model, t_span, t_eval=t_eval, monitors=monitors, hooks=hooks, q0=q0, v0=v0,
-                       state0=state0, max_steps=max_steps, progress=bool(progress))
-    if not result.model:   # the model's self-description, for self-describing result files
-        result.model = describe_model(model)
-    return result
+    return integrate(stepper, model, t_span, t_eval=t_eval, monitors=monitors, hooks=hooks, q0=q0, v0=v0,
+                     state0=state0, max_steps=max_steps, progress=bool(progress))

@@ -9,9 +9,10 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.linalg import LinAlgWarning
 
-from ._validate import positive_int
-from .integrators._newton import NewtonOptions, NewtonSolver, NewtonStats
-from ._scale import ROUNDOFF, force_scale
+from . import _validate as validate
+from ._scale import absolute_tolerance
+from .integrators._newton import NewtonSolver
+from .integrators._newton_records import RENAMED_ATOL, NewtonOptions
 from .problem import Model, capabilities
 
 __all__ = ["solve_static", "StaticResult"]
@@ -25,17 +26,19 @@ class StaticResult:
     ----------
     q : ndarray
         Coordinates of the last converged load step (the solution when
-        ``status == "converged"``; never an unconverged iterate).
-    status : {"converged", "failed"}
+        ``status == "success"``; never an unconverged iterate).
+    status : {"success", "failed"}
+        As :attr:`ancfdae.Result.status`: "success" when every load step converged.
     message : str
         Says which load step failed and with which residual, if one did.
     iterations : int
         Newton iterations over all load steps.
     steps : list of dict
         Per load step: ``load_factor``, ``iterations``, ``residual``, ``converged``, ``q``.
-    stats : NewtonStats
-    cpu_time : float
-        Process time of the solve in seconds.
+    stats : dict
+        Work counters under the names of :attr:`ancfdae.Result.stats`: ``newton_iterations``,
+        ``newton_solves``, ``failed_solves``, ``retries``, ``residual_evals``, ``jacobian_evals``,
+        ``factorizations``, and ``cpu_time`` (process time of the solve in seconds).
     state : dict
         The model's event state after the last converged load step (models with the
         ``"step_events"`` capability, e.g. BE3D's ``{"directors": ...}``); empty otherwise.
@@ -46,18 +49,18 @@ class StaticResult:
     message: str
     iterations: int
     steps: list = field(default_factory=list)
-    stats: NewtonStats = field(default_factory=NewtonStats)
-    cpu_time: float = 0.0
+    stats: dict = field(default_factory=dict)
     state: dict = field(default_factory=dict)
 
     @property
     def success(self) -> bool:
         """True when every load step converged."""
-        return self.status == "converged"
+        return self.status == "success"
 
 
+@validate.renamed("atol", "residual_atol", RENAMED_ATOL)
 def solve_static(model: Model, load_steps: int = 10, *, t: float = 0.0, q0: ArrayLike | None = None, tol: float = 1e-8,
-                 atol: float | None = None, max_iter: int = 25, jacobian: str = "full") -> StaticResult:
+                 residual_atol: float | None = None, max_iter: int = 25, jacobian: str = "full") -> StaticResult:
     """Solve ``r(t, q, 0, 0) = 0`` with the loads applied in uniform steps.
 
     Load step ``i`` solves for the load factor ``lambda_i = i / load_steps``,
@@ -79,15 +82,18 @@ def solve_static(model: Model, load_steps: int = 10, *, t: float = 0.0, q0: Arra
     tol : float
         Relative tolerance: a load step converges when ``max|r| <= tol *
         max|r_0|``, ``r_0`` the residual at its start (the chapter's test).
-    atol : float, optional
-        Absolute floor in the residual's units. By default it is derived from
-        round-off, ``ROUNDOFF * eps * force_scale(model, t, q0)`` at full load
-        (see :func:`ancfdae._scale.force_scale`), never a fixed number of newtons: a 1e-10 N
-        tip load on a micro-fibre is then solved, not declared converged
+    residual_atol : float, optional
+        Absolute tolerance on the residual, in its units (formerly ``atol``). By
+        default it is derived from round-off, ``ATOL_ROUNDOFF * eps *
+        force_scale(model, t, q0)`` at full load (see
+        :func:`ancfdae._scale.absolute_tolerance`), never a fixed number of newtons:
+        a 1e-10 N tip load on a micro-fibre is then solved, not declared converged
         before the first iteration.
-    max_iter, jacobian
-        Newton options, see :class:`ancfdae.integrators._newton.NewtonOptions`
-        (``jacobian="full"`` is the chapter's classical Newton).
+    max_iter : int
+        Newton iterations allowed per load step.
+    jacobian : {"full", "modified"}
+        Newton's refresh policy (:class:`ancfdae.integrators.NewtonOptions`);
+        ``"full"`` is the chapter's classical Newton.
 
     Returns
     -------
@@ -96,7 +102,7 @@ def solve_static(model: Model, load_steps: int = 10, *, t: float = 0.0, q0: Arra
         and a message naming the load step and its residual; ``q`` is then the
         last converged step's solution.
     """
-    load_steps = positive_int("load_steps", load_steps)
+    load_steps = validate.positive_int("load_steps", load_steps)
     if load_steps > 1 and not hasattr(model, "load_factor"):
         raise ValueError("`model` must have a `load_factor` attribute for load stepping; "
                          f"use load_steps=1 with {type(model).__name__}.")
@@ -106,12 +112,12 @@ def solve_static(model: Model, load_steps: int = 10, *, t: float = 0.0, q0: Arra
     q = model.initial_state()[0].copy() if q0 is None else np.array(q0, dtype=float)
     if q.shape != (model.n_dof,):
         raise ValueError(f"`q0` must have shape ({model.n_dof},), got {q.shape}.")
-    if atol is None:
-        atol = ROUNDOFF * np.finfo(float).eps * force_scale(model, t, q)
-    solver = NewtonSolver(NewtonOptions(tol=tol, atol=atol, max_iter=max_iter, jacobian=jacobian))
+    if residual_atol is None:
+        residual_atol = absolute_tolerance(model, t, q)
+    solver = NewtonSolver(NewtonOptions(tol=tol, residual_atol=residual_atol, max_iter=max_iter, jacobian=jacobian))
     z = np.zeros(model.n_dof)
     saved = getattr(model, "load_factor", None)
-    steps, status, message = [], "converged", f"converged in {load_steps} load steps"
+    steps, status, message = [], "success", f"converged in {load_steps} load steps"
     start = _time.process_time()
     try:
         for i in range(1, load_steps + 1):
@@ -128,7 +134,7 @@ def solve_static(model: Model, load_steps: int = 10, *, t: float = 0.0, q0: Arra
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always", LinAlgWarning)
                 out = solver.solve(lambda x, m=m: m.residual(t, x, z, z), lambda x, m=m: m.jacobian(t, x, z, z).K,
-                                   q, residual_jacobian=fused)
+                                   q, residual_atol=residual_atol, residual_jacobian=fused)
             singular = [w for w in caught if issubclass(w.category, LinAlgWarning)]
             for w in caught:
                 if w not in singular or out.converged:
@@ -152,6 +158,7 @@ def solve_static(model: Model, load_steps: int = 10, *, t: float = 0.0, q0: Arra
     finally:
         if saved is not None:
             model.load_factor = saved
+    stats = solver.stats.as_stats()
+    stats["cpu_time"] = _time.process_time() - start
     return StaticResult(q=q, status=status, message=message,
-                        iterations=sum(s["iterations"] for s in steps), steps=steps,
-                        stats=solver.stats, cpu_time=_time.process_time() - start, state=state)
+                        iterations=sum(s["iterations"] for s in steps), steps=steps, stats=stats, state=state)

@@ -46,9 +46,9 @@ def run_once(model, name, h, steps):
     q0, v0 = model.initial_state()
     a0, _ = consistent_acceleration(model, 0.0, q0, v0)
     integ = METHODS[name](model, h)
-    integ.initialize(0.0, q0, v0, a0, 1e9)
+    integ.initialize(model, 0.0, q0, v0, a0, 1e9)
     integ.step()                                    # warm up: JIT, factorisation
-    integ.initialize(0.0, q0, v0, a0, 1e9)
+    integ.initialize(model, 0.0, q0, v0, a0, 1e9)
     t0 = time.process_time()
     for _ in range(steps):
         out = integ.step()

@@ -171,7 +171,7 @@ def run_case(case: dict) -> dict:
     q = np.array([s["q"] for s in row.pop("load_steps")])
     lam = np.array(row.pop("load_factors"), dtype=float)
     zeros = np.zeros_like(q)
-    result = Result(t=lam, q=q, v=zeros, a=zeros, status="success" if row["status"] == "converged" else "failed",
+    result = Result(t=lam, q=q, v=zeros, a=zeros, status=row["status"],
                     message=row["message"], stats={"newton_iterations": row["iterations"]}, method="static-newton",
                     options={"load_steps": 10, "tol": 1e-8})
     return dict(row, result=result)

@@ -238,6 +238,6 @@ def test_damped_model_refused():
     I = EnergyMomentum(model, 1e-2)
     q, v = model.initial_state()
     with pytest.raises(ValueError, match="velocity-dependent"):
-        I.initialize(0.0, q, v, np.zeros_like(q), 1.0)
+        I.initialize(model, 0.0, q, v, np.zeros_like(q), 1.0)
     res = simulate(model, (0.0, 1.0), "energy-momentum", h=1e-2)
     assert not res.success and "velocity-dependent" in res.message

@@ -126,7 +126,7 @@ def test_failure_returns_partial_result(method, opts):
 def test_unconverged_step_is_never_accepted(cls):
     """max_iter=1 with a tight tolerance: the first step fails and the state stays at t0."""
     model = DoublePendulum()
-    integ = cls(model, 0.05, newton=NewtonOptions(max_iter=1, tol=1e-14, atol=0.0, jacobian="full"))
+    integ = cls(model, 0.05, newton=NewtonOptions(max_iter=1, tol=1e-14, residual_atol=0.0, jacobian="full"))
     res = integ.run((0.0, 1.0))
     assert res.status == "failed" and res.t_fail == 0.0 and "failed" in res.message
     assert res.t.size == 1 and model.accepted == []
@@ -140,7 +140,7 @@ def test_step_by_step_api():
     model = SpringChain(2)
     integ = LobattoIIIA(model, 0.01)
     q0, v0 = model.initial_state()
-    integ.initialize(0.0, q0, v0, np.linalg.solve(model.mass(q0).toarray(), -model.residual(0, q0, v0, 0 * q0)),
+    integ.initialize(model, 0.0, q0, v0, np.linalg.solve(model.mass(q0).toarray(), -model.residual(0, q0, v0, 0 * q0)),
                      1.0)
     for _ in range(5):
         out = integ.step()

@@ -12,7 +12,7 @@ from ancfdae.integrators import NewtonOptions
 from toy_models import DoublePendulum
 
 T = 1.0
-NEWTON = NewtonOptions(tol=1e-13, atol=0.0)
+NEWTON = NewtonOptions(tol=1e-13, residual_atol=0.0)
 
 
 def _model():

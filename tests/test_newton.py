@@ -3,7 +3,9 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from ancfdae.integrators import NewtonOptions, NewtonSolver, NewtonStats
+from ancfdae.integrators import NewtonOptions
+from ancfdae.integrators._newton import NewtonSolver
+from ancfdae.integrators._newton_records import NewtonStats
 
 
 def _system(n=12, c=3.0):
@@ -24,7 +26,7 @@ def _system(n=12, c=3.0):
 @pytest.mark.parametrize("mode", ["full", "modified"])
 def test_converges_to_root(mode):
     res, jac, x_star = _system()
-    solver = NewtonSolver(NewtonOptions(jacobian=mode, tol=1e-12, atol=0.0))
+    solver = NewtonSolver(NewtonOptions(jacobian=mode, tol=1e-12, residual_atol=0.0))
     out = solver.solve(res, jac, np.zeros_like(x_star))
     assert out.converged, out.message
     np.testing.assert_allclose(out.x, x_star, atol=1e-10)
@@ -42,7 +44,7 @@ def test_full_newton_is_quadratic():
         norms.append(np.max(np.abs(r)))
         return r
 
-    NewtonSolver(NewtonOptions(jacobian="full", tol=1e-14, atol=0.0)).solve(tracked, jac, 0.5 * x_star)
+    NewtonSolver(NewtonOptions(jacobian="full", tol=1e-14, residual_atol=0.0)).solve(tracked, jac, 0.5 * x_star)
     e = np.array(norms)
     e = e[e > 1e-13]
     # quadratic: log e_{k+1} ~ 2 log e_k in the asymptotic range
@@ -126,10 +128,10 @@ def test_singular_matrix_fails_cleanly():
 
 
 def test_atol_floor_and_exact_initial_guess():
-    s = NewtonSolver(NewtonOptions(atol=1e-6))
+    s = NewtonSolver(NewtonOptions(residual_atol=1e-6))
     out = s.solve(lambda x: x - 1.0 + 1e-7, lambda x: sp.eye(1, format="csr"), np.array([1.0]))
     assert out.converged and out.iterations == 0
-    out = NewtonSolver(NewtonOptions(atol=0.0)).solve(lambda x: x - 1.0, lambda x: sp.eye(1, format="csr"),
+    out = NewtonSolver(NewtonOptions(residual_atol=0.0)).solve(lambda x: x - 1.0, lambda x: sp.eye(1, format="csr"),
                                                       np.array([1.0]))
     assert out.converged and out.iterations == 0
 
@@ -154,7 +156,7 @@ def test_stats_add():
 
 @pytest.mark.parametrize("kw, word", [
     ({"tol": 0.0}, "tol"), ({"tol": 1.5}, "tol"), ({"tol": float("nan")}, "tol"), ({"tol": "1e-8"}, "tol"),
-    ({"atol": -1.0}, "atol"), ({"max_iter": 0}, "max_iter"), ({"max_iter": 2.5}, "max_iter"),
+    ({"residual_atol": -1.0}, "residual_atol"), ({"max_iter": 0}, "max_iter"), ({"max_iter": 2.5}, "max_iter"),
     ({"max_iter": True}, "max_iter"), ({"jacobian": "quasi"}, "jacobian"), ({"contraction": 1.0}, "contraction"),
     ({"contraction": 0}, "contraction"), ({"retry": 1}, "retry"),
 ])

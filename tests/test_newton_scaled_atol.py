@@ -1,9 +1,11 @@
 """The time integrators' Newton tolerance follows the problem's force scale (issue 14)."""
 import numpy as np
 import pytest
+import scipy.sparse as sp
 
-from ancfdae import CircularSection, Material, PointForce, simulate
-from ancfdae.integrators import NewtonOptions, NewtonSolver
+from ancfdae import CircularSection, Material, PointForce, simulate, solve_static
+from ancfdae.integrators import NewtonOptions
+from ancfdae.integrators._newton import NewtonSolver
 from ancfdae.models import BE2D, Beam
 
 E, RHO = 70e9, 2500.0
@@ -26,8 +28,8 @@ def _fibre_run(scale, newton=None):
 
 @pytest.fixture(scope="module")
 def micro():
-    return {"default": _fibre_run(1.0), "zero": _fibre_run(1.0, NewtonOptions(atol=0.0)),
-            "fixed": _fibre_run(1.0, NewtonOptions(atol=1e-10))}
+    return {"default": _fibre_run(1.0), "zero": _fibre_run(1.0, NewtonOptions(residual_atol=0.0)),
+            "fixed": _fibre_run(1.0, NewtonOptions(residual_atol=1e-10))}
 
 
 def test_micro_fibre_default_tolerance_scales(micro):
@@ -51,14 +53,30 @@ def test_same_run_scaled_by_1e6_gives_same_dimensionless_result(micro):
     assert abs(w_big / w - 1) < 2e-6
 
 
-def test_explicit_atol_is_used_and_none_means_derived():
-    # Catches an explicit atol being overwritten by the derived one, or None reaching the comparison.
-    s = NewtonSolver(NewtonOptions(atol=1e-6))
-    s.scaled_atol = 1.0
-    assert s.atol == 1e-6
-    s = NewtonSolver()
-    assert s.options.atol is None and s.atol == 0.0
-    s.scaled_atol = 3e-7
-    assert s.atol == 3e-7
-    with pytest.raises(ValueError, match="atol"):
-        NewtonOptions(atol=-1.0)
+def test_residual_atol_is_a_per_solve_argument():
+    # Catches the per-solve tolerance being ignored, the options' value not being the default, or None
+    # reaching the comparison (the solver keeps no tolerance of its own).
+    def f(x):
+        return x - 1.0 + 1e-7
+
+    def jac(x):
+        return sp.eye(1, format="csr")
+
+    s = NewtonSolver(NewtonOptions(residual_atol=1e-6))
+    assert s.solve(f, jac, np.array([1.0])).iterations == 0                       # the options' 1e-6
+    assert s.solve(f, jac, np.array([1.0]), residual_atol=1e-8).iterations == 1   # the argument wins
+    assert NewtonSolver().solve(f, jac, np.array([1.0])).iterations == 1          # None: 0
+    with pytest.raises(ValueError, match="residual_atol"):
+        NewtonOptions(residual_atol=-1.0)
+
+
+def test_the_old_atol_keyword_names_its_new_name():
+    # Catches a rename that leaves users with Python's bare "unexpected keyword argument".
+    beam = Beam(BE2D(Material(E=E, nu=0.2, rho=RHO), CircularSection(1e-3)), 2, 1.0, supports={0: "clamp"},
+                loads=[PointForce((0.0, 1e-3), node=-1)])
+    with pytest.raises(TypeError, match="`atol` was renamed `residual_atol`.*IDA"):
+        NewtonOptions(atol=1e-6)
+    with pytest.raises(TypeError, match="residual_atol"):
+        simulate(beam, (0.0, 0.1), "lobatto3", h=0.01, newton={"atol": 0.0})
+    with pytest.raises(TypeError, match="residual_atol"):
+        solve_static(beam, atol=1e-6)

@@ -122,7 +122,7 @@ def test_a_users_element_rebuilds_from_the_file_by_its_name(tmp_path):
 
 def test_failed_result_round_trip(tmp_path):
     res = simulate(SpringChain(2), (0, 1), "newmark", h=0.05, monitors=[EnergyMonitor()],
-                   newton={"max_iter": 1, "tol": 1e-14, "atol": 0.0, "jacobian": "full"})
+                   newton={"max_iter": 1, "tol": 1e-14, "residual_atol": 0.0, "jacobian": "full"})
     assert not res.success
     back = Result.load(res.save(tmp_path / "failed.nc"))
     assert back.status == "failed" and back.t_fail == res.t_fail and back.message == res.message

@@ -26,7 +26,7 @@ def test_steps_record_each_converged_load(steel, square):
     res = solve_static(beam, load_steps=4)
     assert [s["load_factor"] for s in res.steps] == [0.25, 0.5, 0.75, 1.0]
     assert all(s["converged"] for s in res.steps)
-    assert res.iterations == sum(s["iterations"] for s in res.steps) == res.stats.iterations
+    assert res.iterations == sum(s["iterations"] for s in res.steps) == res.stats["newton_iterations"]
     tips = [beam.position(s["q"], 2.0)[1] for s in res.steps]
     assert np.all(np.diff(tips) > 0)
 
@@ -108,3 +108,16 @@ def test_unsupported_beam_fails_clearly_without_warning(steel, square):
         res = solve_static(beam)
     assert res.status == "failed"
     assert "singular" in res.message and "supports" in res.message
+
+
+def test_static_result_speaks_the_vocabulary_of_result(steel, square):
+    # Catches StaticResult drifting from Result: "converged" for "success", or stats as a record with
+    # other names than Result.stats (a dataclass there, a dict here).
+    from ancfdae import Result
+    beam = Beam(BE2D(steel, square), 2, 2.0, supports={0: "clamp"}, loads=[PointForce((0.0, 1e3), node=-1)])
+    res = solve_static(beam, load_steps=2)
+    assert res.status == "success" and res.success
+    Result(t=[0.0], q=res.q[None], v=0 * res.q[None], a=0 * res.q[None], status=res.status)   # a valid status
+    assert {"newton_iterations", "newton_solves", "residual_evals", "jacobian_evals", "factorizations",
+            "cpu_time"} <= set(res.stats)
+    assert res.stats["newton_iterations"] == res.iterations > 0

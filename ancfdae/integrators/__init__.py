@@ -1,21 +1,24 @@
 """Interchangeable time integrators; each consumes only the Model contract.
 
-Fixed step: :class:`LobattoIIIA` (2 or 3 stages), :class:`Newmark`, :class:`HHTAlpha`,
-:class:`GeneralizedAlpha`, :class:`EnergyMomentum` (discrete-gradient midpoint rule: energy and
-momenta kept exactly, constant-mass models); variable step: :class:`IDA` (SUNDIALS, scikit-sundae imported lazily).
-Each is a stepper of the :class:`~ancfdae.integrators.protocol.Integrator` protocol, run by the
-one driver (:func:`ancfdae.integrators.driver.integrate`, behind :func:`ancfdae.simulate` and
-``Integrator.run``).
+Fixed step: :class:`LobattoIIIA` (:class:`Lobatto3`, :class:`Lobatto2`), :class:`Newmark`,
+:class:`HHTAlpha`, :class:`GeneralizedAlpha`, :class:`EnergyMomentum` (discrete-gradient midpoint
+rule: energy and momenta kept exactly, constant-mass models); variable step: :class:`IDA` (SUNDIALS,
+scikit-sundae imported lazily). Each is a stepper run by the one driver (:func:`integrate`, behind
+:func:`ancfdae.simulate` and :meth:`Integrator.run`). Subclass :class:`Integrator` (any stepper),
+:class:`FixedStepIntegrator` (one ``_step_impl`` on the uniform grid) or :class:`NewtonStepper`
+(and a Newton solve per step) for a method of your own.
 """
-from ancfdae.integrators._base import FixedStepIntegrator
-from ancfdae.integrators._newton import NewtonOptions, NewtonOutcome, NewtonSolver, NewtonStats
+from ancfdae.integrators._newton_records import NewtonOptions
 from ancfdae.integrators.driver import integrate
 from ancfdae.integrators.energy_momentum import EnergyMomentum
+from ancfdae.integrators.fixed_step import FixedStepIntegrator
 from ancfdae.integrators.ida import IDA
-from ancfdae.integrators.protocol import Integrator, Quadrature, StepOutcome
-from ancfdae.integrators.lobatto import LOBATTO_IIIA_2, LOBATTO_IIIA_3, ButcherTableau, LobattoIIIA
+from ancfdae.integrators.integrator import Integrator
+from ancfdae.integrators.lobatto import LOBATTO_IIIA_2, LOBATTO_IIIA_3, ButcherTableau, Lobatto2, Lobatto3, LobattoIIIA
 from ancfdae.integrators.newmark import GeneralizedAlpha, HHTAlpha, Newmark
+from ancfdae.integrators.newton_stepper import NewtonStepper
+from ancfdae.integrators.protocol import Quadrature, StepOutcome
 
-__all__ = ["NewtonOptions", "NewtonOutcome", "NewtonSolver", "NewtonStats", "FixedStepIntegrator",
-           "LobattoIIIA", "ButcherTableau", "LOBATTO_IIIA_2", "LOBATTO_IIIA_3", "Newmark", "HHTAlpha",
-           "GeneralizedAlpha", "EnergyMomentum", "IDA", "Integrator", "StepOutcome", "Quadrature", "integrate"]
+__all__ = ["Integrator", "FixedStepIntegrator", "NewtonStepper", "StepOutcome", "Quadrature", "NewtonOptions",
+           "LobattoIIIA", "Lobatto3", "Lobatto2", "ButcherTableau", "LOBATTO_IIIA_2", "LOBATTO_IIIA_3", "Newmark",
+           "HHTAlpha", "GeneralizedAlpha", "EnergyMomentum", "IDA", "integrate"]

@@ -86,7 +86,6 @@ class AVFGradient:
         n = max(1, -(-int(degree) // 2))            # ceil(degree / 2) points: exact to degree 2n - 1
         s, w = gauss(n)
         self.s, self.w = (s + 1.0) / 2.0, w / 2.0
-        self.evals = 0
 
     def start(self, t, q0):
         """Fix the step's start ``q0`` and the time at which ``P`` is evaluated."""
@@ -95,7 +94,6 @@ class AVFGradient:
     def gradient(self, x):
         """``G(q0, x)``."""
         d = x - self.q0
-        self.evals += self.s.size
         return sum(w * self.model.potential_gradient(self.t, self.q0 + s * d, False)[0]
                    for s, w in zip(self.s, self.w))
 
@@ -137,7 +135,6 @@ class GonzalezGradient:
         self._A_all = sp.csr_matrix(sp.vstack(self.A)) if self.A else None
         self._Mop = self.M.toarray() if n <= DENSE_MAX else self.M
         self._MT = self._Mop @ self.T
-        self.evals = 0
 
     def start(self, t, q0):
         """Fix the step's start ``q0``; evaluates ``P(q0)`` once per step."""
@@ -149,7 +146,6 @@ class GonzalezGradient:
         d = x - self.q0
         mid = self.q0 + 0.5 * d
         g, K = m.potential_gradient(self.t, mid, tangent)
-        self.evals += 1
         N = m.potential(self.t, x) - self.P0 - g @ d
         if self.T.size or self.A:
             if self.A:
@@ -187,7 +183,6 @@ class GonzalezGradient:
         if c == 0.0:
             return 0.5 * K
         gx = self.model.potential_gradient(self.t, x, False)[0]
-        self.evals += 1
         dN = gx - p["g"] - 0.5 * (K @ d)
         nt = self.T.shape[1]
         if p["S"] is None:

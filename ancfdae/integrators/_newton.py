@@ -29,7 +29,7 @@ from numba import njit
 from ._linsolve import factorize
 from ._newton_records import NewtonOptions, NewtonOutcome, NewtonStats
 
-__all__ = ["NewtonOptions", "NewtonStats", "NewtonOutcome", "NewtonSolver"]
+__all__ = ["NewtonSolver", "max_abs"]
 
 #: A rate above this with a matrix evaluated during the current attempt counts
 #: as divergence; two such iterations in a row end the attempt early.
@@ -76,25 +76,16 @@ class NewtonSolver:
     stats : NewtonStats
         Cumulative counters over every call.
 
-    scaled_atol : float
-        The absolute tolerance used when ``options.atol`` is ``None``, set by
-        the caller from the problem's force scale (``0`` until it does).
-    residual_floor : float
-        Absolute round-off floor of the residual that the caller may set (and
-        update, e.g. at every Jacobian evaluation): the convergence test is
-        ``max|r_k| <= max(tol * max|r_0|, atol, residual_floor)`` (``atol`` the
-        property below). The
-        integrators set it to ``ROUNDOFF * eps * max|K| * max(1, max|q|)``:
-        a residual of elastic forces cannot be computed more accurately than
-        that (measured: 4e-7 N on Exudyn's 25-element BE2D pendulum, where
-        ``tol * max|r_0|`` of a 1e-4 s step can be 2.5e-7 N).
-
     Notes
     -----
-    The solver keeps at most one factorisation. The caller must call
-    :meth:`invalidate` whenever the meaning of the Jacobian changes in a way
-    the contraction test cannot be trusted to detect (new step size, new
-    iteration-matrix coefficients, different equations).
+    A solve converges when ``max|r_k| <= max(tol * max|r_0|, residual_atol, floor)``. The two
+    absolute levels are arguments of :meth:`solve`, never state of the solver: ``residual_atol`` is
+    the caller's tolerance (the steppers derive it once per run from the problem's force scale), and
+    ``floor`` the round-off level of the residual, which the caller knows from its stiffness (see
+    :mod:`ancfdae._scale`). The solver keeps at most one factorisation. The caller must call
+    :meth:`invalidate` whenever the meaning of the Jacobian changes in a way the contraction test
+    cannot be trusted to detect (new step size, new iteration-matrix coefficients, different
+    equations).
     """
 
     def __init__(self, options: NewtonOptions | None = None) -> None:
@@ -104,15 +95,7 @@ class NewtonSolver:
             raise TypeError(f"`options` must be a NewtonOptions, got {type(options).__name__}.")
         self.options = options
         self.stats = NewtonStats()
-        self.scaled_atol = 0.0
-        self.residual_floor = 0.0
         self._lu: _Factor | None = None
-
-    @property
-    def atol(self) -> float:
-        """The absolute tolerance in force: ``options.atol``, or :attr:`scaled_atol` when that is ``None``."""
-        a = self.options.atol
-        return self.scaled_atol if a is None else a
 
     def invalidate(self) -> None:
         """Drop the cached factorisation; the next iteration refactorises."""
@@ -123,17 +106,21 @@ class NewtonSolver:
         """True while a factorisation is cached."""
         return self._lu is not None
 
-    def _refresh(self, jacobian, x, J=None):
+    def _refresh(self, jacobian, x, J, floor, keep_max):
+        """Evaluate (unless given) and factorise the matrix; returns ``(error message or None, floor)``."""
         if J is None:
             J = jacobian(x)
+            if type(J) is tuple:      # (matrix, the residual's round-off floor at x)
+                J, new = J
+                floor = max(floor, new) if keep_max else new
         self.stats.jacobian_evals += 1
         try:
             self._lu = _Factor(J)
         except RuntimeError as exc:  # SuperLU: "Factor is exactly singular"
             self._lu = None
-            return f"factorisation failed: {exc}"
+            return f"factorisation failed: {exc}", floor
         self.stats.factorizations += 1
-        return None
+        return None, floor
 
     def _eval(self, residual, x):
         self.stats.residual_evals += 1
@@ -158,6 +145,10 @@ class NewtonSolver:
         residual: Callable[[np.ndarray], np.ndarray],
         jacobian: Callable[[np.ndarray], object],
         x0: ArrayLike,
+        *,
+        residual_atol: float | None = None,
+        floor: float = 0.0,
+        floor_update: str = "max",
         residual_jacobian: Callable[[np.ndarray], tuple] | None = None,
     ) -> NewtonOutcome:
         """Iterate from ``x0`` until the residual test passes.
@@ -168,9 +159,23 @@ class NewtonSolver:
             ``residual(x) -> ndarray`` of the shape of ``x``.
         jacobian : callable
             ``jacobian(x) -> d residual / dx`` as a scipy sparse matrix or a
-            dense 2-D array.
+            dense 2-D array; or ``jacobian(x) -> (matrix, floor)`` with the
+            round-off floor of the residual at ``x`` (see :mod:`ancfdae._scale`),
+            which updates ``floor`` from that iteration on (``floor_update``).
         x0 : array_like
             Initial guess (not modified).
+        residual_atol : float, optional
+            Absolute tolerance of this solve, in the residual's units.
+            Default: ``options.residual_atol``, 0 when that is None.
+        floor : float
+            The residual's round-off floor at the start of this solve (the
+            caller's, carried from its earlier solves: a modified Newton solve
+            may start with an earlier matrix).
+        floor_update : {"max", "replace"}
+            How a floor that comes with a new matrix updates the one in effect:
+            ``"max"`` keeps the larger (a running maximum, when the caller
+            carries it over a run), ``"replace"`` takes the new one (the floor
+            of the matrix in use).
         residual_jacobian : callable, optional
             ``residual_jacobian(x) -> (residual, jacobian)`` in one pass. With
             full Newton every residual is followed by a Jacobian at the same
@@ -182,8 +187,14 @@ class NewtonSolver:
         -------
         NewtonOutcome
             Never raises on non-convergence; exceptions raised by the
-            callbacks propagate.
+            callbacks propagate. ``floor`` is the floor in effect at the end,
+            to start the next solve with.
         """
+        if residual_atol is None:
+            residual_atol = self.options.residual_atol or 0.0
+        keep_max = floor_update == "max"
+        if not keep_max and floor_update != "replace":
+            raise ValueError(f"`floor_update` must be one of ['max', 'replace'], got {floor_update!r}.")
         fused = residual_jacobian if self.options.jacobian == "full" else None
         x0 = np.array(x0, dtype=float, copy=True).ravel()
         self.stats.solves += 1
@@ -193,26 +204,26 @@ class NewtonSolver:
             r, J = self._eval(residual, x0), None
         if not math.isfinite(max_abs(r)):
             self.stats.failed_solves += 1
-            return NewtonOutcome(x0, False, 0, float("nan"), "residual at the initial guess is not finite")
-        outcome = self._attempt(residual, jacobian, x0, r, fused, J)
-        if (not outcome[0].converged and outcome[1] and self.options.jacobian == "modified"
+            return NewtonOutcome(x0, False, 0, float("nan"), "residual at the initial guess is not finite", floor)
+        outcome, stale = self._attempt(residual, jacobian, x0, r, residual_atol, floor, keep_max, fused, J)
+        if (not outcome.converged and stale and self.options.jacobian == "modified"
                 and self.options.retry):
             # The failed attempt started from a matrix of an earlier solve:
             # retry once from the initial guess with a fresh one.
             self.stats.retries += 1
             self.invalidate()
-            first = outcome[0]
-            retry, _ = self._attempt(residual, jacobian, x0, r)
-            outcome = (NewtonOutcome(retry.x, retry.converged, first.iterations + retry.iterations,
-                                     retry.residual_norm,
-                                     retry.message if retry.converged else
-                                     f"{retry.message} (after a retry with a fresh Jacobian; "
-                                     f"first attempt: {first.message})"), False)
-        if not outcome[0].converged:
+            first = outcome
+            retry, _ = self._attempt(residual, jacobian, x0, r, residual_atol, first.floor, keep_max)
+            outcome = NewtonOutcome(retry.x, retry.converged, first.iterations + retry.iterations,
+                                    retry.residual_norm,
+                                    retry.message if retry.converged else
+                                    f"{retry.message} (after a retry with a fresh Jacobian; "
+                                    f"first attempt: {first.message})", retry.floor)
+        if not outcome.converged:
             self.stats.failed_solves += 1
-        return outcome[0]
+        return outcome
 
-    def _attempt(self, residual, jacobian, x0, r, fused=None, J=None):
+    def _attempt(self, residual, jacobian, x0, r, atol, floor, keep_max, fused=None, J=None):
         """One Newton attempt; returns (outcome, started_with_stale_matrix).
 
         With ``fused`` (full Newton and a ``residual_jacobian``), ``J`` is the
@@ -223,25 +234,25 @@ class NewtonSolver:
         stale = self._lu is not None and not full
         x = x0.copy()
         err0 = err = max_abs(r)
-        rel = max(opts.tol * err0, self.atol)
-        threshold = max(rel, self.residual_floor)
+        rel = max(opts.tol * err0, atol)
+        threshold = max(rel, floor)
         if err <= threshold:
-            return NewtonOutcome(x, True, 0, err, "converged at the initial guess"), stale
+            return NewtonOutcome(x, True, 0, err, "converged at the initial guess", floor), stale
         fresh = False  # the cached matrix was evaluated during this attempt
         diverging = 0
         for k in range(1, opts.max_iter + 1):
             if full or self._lu is None:
-                msg = self._refresh(jacobian, x, J)
+                msg, floor = self._refresh(jacobian, x, J, floor, keep_max)
                 if msg is not None:
-                    return NewtonOutcome(x, False, k - 1, err, msg), stale
+                    return NewtonOutcome(x, False, k - 1, err, msg, floor), stale
                 fresh = True
-                threshold = max(rel, self.residual_floor)  # the caller may update it with the Jacobian
+                threshold = max(rel, floor)  # a new matrix may bring a new floor
             dx = self._lu.solve(r)   # the correction is -dx (negation commutes exactly with the solve)
             self.stats.iterations += 1
             dx_max = max_abs(dx)  # NaN/inf propagate into the max
             if not math.isfinite(dx_max):   # math: 20x cheaper than np on a float
                 return NewtonOutcome(x, False, k, err, "Newton correction is not finite "
-                                     "(singular iteration matrix?)"), stale
+                                     "(singular iteration matrix?)", floor), stale
             x = x - dx
             if fused is not None:
                 r, J = self._eval_fused(fused, x)
@@ -250,15 +261,15 @@ class NewtonSolver:
             err_new = max_abs(r)
             if not math.isfinite(err_new):
                 return NewtonOutcome(x, False, k, float("nan"),
-                                     f"residual became non-finite at iteration {k}"), stale
+                                     f"residual became non-finite at iteration {k}", floor), stale
             if err_new <= threshold:
-                return NewtonOutcome(x, True, k, err_new, f"converged in {k} iterations"), stale
+                return NewtonOutcome(x, True, k, err_new, f"converged in {k} iterations", floor), stale
             # Round-off stagnation: a fresh matrix, a correction at round-off
             # level and a residual that no longer falls -- the attainable accuracy.
             if (fresh and err_new > 0.5 * err
                     and dx_max <= opts.xtol * max(1.0, max_abs(x))):
                 return NewtonOutcome(x, True, k, err_new, f"converged in {k} iterations "
-                                     f"(correction at round-off level, max|r| = {err_new:.3e})"), stale
+                                     f"(correction at round-off level, max|r| = {err_new:.3e})", floor), stale
             rate = err_new / err if err > 0 else np.inf
             err = err_new
             if rate > opts.contraction:
@@ -266,7 +277,7 @@ class NewtonSolver:
                     diverging += 1
                     if diverging >= 2:
                         return NewtonOutcome(x, False, k, err, f"diverging (rate {rate:.3g} at "
-                                             f"iteration {k} with a fresh Jacobian)"), stale
+                                             f"iteration {k} with a fresh Jacobian)", floor), stale
                 else:
                     diverging = 0
                 if not full:
@@ -275,4 +286,4 @@ class NewtonSolver:
                 diverging = 0
         return NewtonOutcome(x, False, opts.max_iter, err,
                              f"not converged in {opts.max_iter} iterations "
-                             f"(max|r| = {err:.3e}, target {threshold:.3e})"), stale
+                             f"(max|r| = {err:.3e}, target {threshold:.3e})", floor), stale

@@ -1,7 +1,9 @@
 """The records of the Newton solver: its options, its work counters and the outcome of one solve.
 
-Kept apart from the iteration itself (:mod:`ancfdae.integrators._newton`), which imports and
-re-exports them.
+Kept apart from the iteration itself (:mod:`ancfdae.integrators._newton`). Only
+:class:`NewtonOptions` is public (users pass it to the steppers); the counters and the outcome are the
+solver's own: a stepper reports its work as the plain dict of :meth:`NewtonStats.as_stats`, the static
+solver likewise.
 """
 from __future__ import annotations
 
@@ -10,7 +12,13 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from ancfdae import _validate as validate
+
 __all__ = ["NewtonOptions", "NewtonStats", "NewtonOutcome"]
+
+#: Why ``atol`` became ``residual_atol``: the same word meant a tolerance on the state for IDA.
+RENAMED_ATOL = ("Newton's absolute tolerance on the residual, in the residual's units; `atol` is IDA's "
+                "tolerance on the state")
 
 
 def _real(name, value, *, low=None, high=None, low_open=False, high_open=False):
@@ -25,6 +33,7 @@ def _real(name, value, *, low=None, high=None, low_open=False, high_open=False):
     return float(value)
 
 
+@validate.renamed("atol", "residual_atol", RENAMED_ATOL)
 @dataclass(frozen=True)
 class NewtonOptions:
     """Tolerances and policy of :class:`NewtonSolver`.
@@ -35,17 +44,18 @@ class NewtonOptions:
         Relative tolerance: converged when ``max|r_k| <= tol * max|r_0|`` with
         ``r_0`` the residual at the initial guess of the solve (the chapter's
         criterion, Sects. 5.1-5.2, with ``tol = 1e-8``). In ``(0, 1)``.
-    atol : float or None
-        Absolute floor, in the residual's own units (forces, for the models of
-        this package): also converged when ``max|r_k| <= atol``. It settles
-        solves whose initial residual is already negligible (relative
-        reduction of a round-off-sized residual is impossible). ``None`` (the
-        default) derives it from the problem: the integrators set
-        :attr:`NewtonSolver.scaled_atol` to ``ROUNDOFF * eps * force_scale``
-        of the initial state (:mod:`ancfdae._scale`), so a 1 um fibre and a
-        100 m beam get floors of their own size; a solver nobody scales uses
-        ``0`` (the relative test and the round-off floors alone). A number is
-        used as given. ``>= 0``.
+    residual_atol : float or None
+        Absolute tolerance on the residual, in the residual's own units
+        (forces, for the models of this package): also converged when
+        ``max|r_k| <= residual_atol``. It settles solves whose initial
+        residual is already negligible (relative reduction of a
+        round-off-sized residual is impossible). ``None`` (the default)
+        derives it from the problem: a stepper uses
+        ``ATOL_ROUNDOFF * eps * force_scale`` of the initial state
+        (:func:`ancfdae._scale.absolute_tolerance`), so a 1 um fibre and a
+        100 m beam get tolerances of their own size. A number is used as
+        given. ``>= 0``. (Formerly ``atol``, renamed because IDA's ``atol``
+        is a tolerance on the state.)
     max_iter : int
         Iterations allowed per attempt (per retry as well). ``>= 1``.
     jacobian : {"modified", "full"}
@@ -66,7 +76,7 @@ class NewtonOptions:
     """
 
     tol: float = 1e-8
-    atol: float | None = None
+    residual_atol: float | None = None
     max_iter: int = 25
     jacobian: str = "modified"
     contraction: float = 0.3
@@ -75,8 +85,8 @@ class NewtonOptions:
 
     def __post_init__(self):
         _real("tol", self.tol, low=0.0, high=1.0, low_open=True, high_open=True)
-        if self.atol is not None:
-            _real("atol", self.atol, low=0.0)
+        if self.residual_atol is not None:
+            _real("residual_atol", self.residual_atol, low=0.0)
         if isinstance(self.max_iter, bool) or not isinstance(self.max_iter, numbers.Integral) or self.max_iter < 1:
             raise ValueError(f"`max_iter` must be a positive integer, got {self.max_iter!r}.")
         if self.jacobian not in ("modified", "full"):
@@ -122,9 +132,12 @@ class NewtonStats:
             return NotImplemented
         return NewtonStats(**{f.name: getattr(self, f.name) + getattr(other, f.name) for f in fields(self)})
 
-    def as_dict(self) -> dict:
-        """The counters as a plain dict."""
-        return {f.name: getattr(self, f.name) for f in fields(self)}
+    def as_stats(self) -> dict:
+        """The counters under the names of ``Result.stats`` (``newton_iterations``, ``newton_solves``, ...)."""
+        return {"newton_iterations": self.iterations, "newton_solves": self.solves,
+                "failed_solves": self.failed_solves, "retries": self.retries,
+                "residual_evals": self.residual_evals, "jacobian_evals": self.jacobian_evals,
+                "factorizations": self.factorizations}
 
 
 @dataclass(frozen=True)
@@ -141,6 +154,10 @@ class NewtonOutcome:
     residual_norm : float
         ``max|r|`` at ``x``.
     message : str
+        How the solve ended (the reason when it failed).
+    floor : float
+        The residual's round-off floor in effect at the end (that of the last
+        matrix evaluated, else the one the solve was given).
     """
 
     x: np.ndarray
@@ -148,3 +165,4 @@ class NewtonOutcome:
     iterations: int
     residual_norm: float
     message: str
+    floor: float = 0.0

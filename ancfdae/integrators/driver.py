@@ -4,7 +4,10 @@
 the consistent initial acceleration, output times (grid hits and the stepper's interpolation inside
 a step), monitors (each step's :class:`~.protocol.Quadrature` is passed to ``Monitor.advance``),
 hooks, model events (the ``"step_events"`` capability of :mod:`ancfdae.problem`: BE3D's director
-update), failure handling and the :class:`~ancfdae.result.Result`.
+update), failure handling and the :class:`~ancfdae.result.Result` with the model's description.
+It hands the stepper everything through arguments: ``initialize(model, t0, q0, v0, a0, t_bound,
+want_quadrature=...)`` and ``restart(t, q, v, a, model)``. It needs only the :mod:`.protocol`, so
+the stepper base (:mod:`.integrator`, whose ``run`` calls this driver) stands above it.
 
 Failure handling: a failed step, a monitor asking to stop, or an exception raised by anything
 called during the run -- the model (e.g. a load's time function), a hook, a monitor, the stepper --
@@ -24,12 +27,13 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike
 
-from ancfdae import _validate as V
+from ancfdae import _validate as validate
+from ancfdae._resultfile import describe_model
 from ancfdae.integrators._recorder import Recorder
+from ancfdae.integrators.protocol import Stepper
 from ancfdae.problem import Model, capabilities
 
-if TYPE_CHECKING:                       # these modules import the driver
-    from ancfdae.integrators.protocol import Integrator
+if TYPE_CHECKING:                       # for annotations only
     from ancfdae.monitors import Monitor
     from ancfdae.result import Result
 
@@ -84,7 +88,7 @@ def output_times(t_span: tuple[float, float],
         raise ValueError(f"`t_span` must satisfy t0 < tf (finite), got {t_span!r}.")
     if t_eval is None:
         return t0, tf, None
-    te = V.finite_vector("t_eval", t_eval)
+    te = validate.finite_vector("t_eval", t_eval)
     if te.size == 0:
         raise ValueError("`t_eval` must hold at least one time, got an empty array.")
     if np.any(np.diff(te) <= 0):
@@ -96,8 +100,8 @@ def output_times(t_span: tuple[float, float],
 
 def _initial_state(model, n, q0, v0, state0, events):
     q_i, v_i = model.initial_state() if (q0 is None or v0 is None) else (None, None)
-    q0 = V.finite_vector("q0", q_i if q0 is None else q0, n).copy()
-    v0 = V.finite_vector("v0", v_i if v0 is None else v0, n).copy()
+    q0 = validate.finite_vector("q0", q_i if q0 is None else q0, n).copy()
+    v0 = validate.finite_vector("v0", v_i if v0 is None else v0, n).copy()
     if not events:
         if state0 is not None:
             raise ValueError(f"`state0` is only for models with the 'step_events' capability; "
@@ -122,7 +126,7 @@ def _initial_state(model, n, q0, v0, state0, events):
 def _check_max_steps(stepper, t0, tf, max_steps):
     if max_steps is None:
         max_steps = DEFAULT_MAX_STEPS
-    max_steps = V.positive_int("max_steps", max_steps)
+    max_steps = validate.positive_int("max_steps", max_steps)
     if getattr(stepper, "fixed_step", False) and stepper.h is not None:
         need = (tf - t0) / stepper.h
         if need > max_steps + GRID_TOL:
@@ -158,16 +162,16 @@ class _Progress:
             self.bar.close()
 
 
-def integrate(stepper: Integrator, model: Model, t_span: tuple[float, float], t_eval: ArrayLike | None = None,
+def integrate(stepper: Stepper, model: Model, t_span: tuple[float, float], t_eval: ArrayLike | None = None,
               monitors: Sequence[Monitor] = (), hooks: Sequence[Callable] = (), q0: ArrayLike | None = None,
               v0: ArrayLike | None = None, state0: dict | None = None, max_steps: int | None = None,
               progress: bool = False) -> Result:
-    """Run ``stepper`` (an :class:`~.protocol.Integrator`) on ``model`` over ``t_span``.
+    """Run ``stepper`` (a :class:`~.protocol.Stepper`) on ``model`` over ``t_span``.
 
     Parameters
     ----------
-    stepper : Integrator
-        The stepper, constructed on ``model``.
+    stepper : Stepper
+        The stepper, constructed on ``model`` (e.g. an :class:`~ancfdae.integrators.Integrator`).
     model : Model
         The equations of motion.
     t_span : (t0, tf)
@@ -192,7 +196,9 @@ def integrate(stepper: Integrator, model: Model, t_span: tuple[float, float], t_
     Returns
     -------
     Result
-        Never raises once the run has started; see the module docstring.
+        Never raises once the run has started; see the module docstring. ``stats`` are the
+        stepper's with the driver's ``model_events``, ``restarts``, ``wall_time`` and ``cpu_time``;
+        ``model`` is ``model``'s description (``describe()`` and ``dof_labels()``, when it has them).
     """
     n = check_model(model)
     caps = capabilities(model)
@@ -206,8 +212,6 @@ def integrate(stepper: Integrator, model: Model, t_span: tuple[float, float], t_
     q0, v0, state = _initial_state(model, n, q0, v0, state0, events)
     bound = model.bind(state) if events else model
     rec = Recorder(bound, monitors)
-    stepper.model = bound
-    stepper.want_quadrature = bool(rec.monitors)
     state_keys = tuple(state) if events else ()
 
     wall, cpu = time.perf_counter(), time.process_time()
@@ -219,7 +223,7 @@ def integrate(stepper: Integrator, model: Model, t_span: tuple[float, float], t_
         a0, reason = consistent_acceleration(bound, t0, q0, v0)
         if a0 is None:
             raise _Failed(f"initial acceleration at t = {t0:g} failed: {reason}")
-        stepper.initialize(t0, q0, v0, a0, tf)
+        stepper.initialize(bound, t0, q0, v0, a0, tf, want_quadrature=bool(rec.monitors))
         rec.start(t0, q0, v0, a0)
         j = 0
         if t_out is None or t_out[0] <= t0:
@@ -280,11 +284,12 @@ def integrate(stepper: Integrator, model: Model, t_span: tuple[float, float], t_
         message, t_fail = f"run ended at t = {t:.9g} by an exception: {type(exc).__name__}: {exc}", t
     finally:
         bar.close()
-    stats = dict(stepper.stats)
-    stats.update(steps=steps, model_events=events_n, restarts=restarts,
+    stats = dict(stepper.stats)     # the stepper's counters, "steps" among them; the driver's beside
+    stats.update(model_events=events_n, restarts=restarts,
                  wall_time=time.perf_counter() - wall, cpu_time=time.process_time() - cpu)
     return rec.result(n, state_keys=state_keys, status=status, message=message, stats=stats, t_fail=t_fail,
-                      method=getattr(stepper, "name", type(stepper).__name__), options=stepper.options())
+                      method=getattr(stepper, "name", type(stepper).__name__), options=stepper.options(),
+                      model=describe_model(model))
 
 
 class _Failed(Exception):

@@ -78,11 +78,12 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ancfdae import _validate as V
-from ancfdae.integrators._base import FixedStepIntegrator
+from ancfdae import _validate as validate
+from ancfdae._scale import ENERGY_ROUNDOFF
 from ancfdae.integrators._discrete_gradient import AVFGradient, GonzalezGradient
-from ancfdae.integrators._newton import NewtonOptions
-from ancfdae.integrators.protocol import Quadrature
+from ancfdae.integrators._newton_records import NewtonOptions
+from ancfdae.integrators.newton_stepper import NewtonStepper
+from ancfdae.integrators.protocol import Quadrature, StepOutcome
 from ancfdae.problem import Model, capabilities
 
 __all__ = ["EnergyMomentum", "DISCRETE_GRADIENTS", "DEFAULT_NEWTON"]
@@ -93,16 +94,10 @@ DISCRETE_GRADIENTS = ("auto", "avf", "gonzalez")
 #: iterations: on B3 with 8 SQ3D elements at h = 10 ms the 0.3 default converged at rate 0.3 and
 #: ran out of 25 iterations at t = 2.35 s; with 0.1/40 the run reaches 4 s at 11.6 iterations per
 #: step (full Newton: 7.3 iterations, 35 % more time).
-DEFAULT_NEWTON = NewtonOptions(tol=1e-15, atol=0.0, contraction=0.1, max_iter=40)
-#: Newton's residual floor is FLOOR * eps * max|dG/dq| * max(1, max|q|), a tenth of the round-off
-#: of the elastic forces: the energy identity inherits the residual r as (q1 - q0) . r, and a
-#: Newton stop above round-off leaves r biased along the step (measured on B2, BE2D, 1 element,
-#: h = 5 ms: mean energy error per step 9.5e-18 J with the factor 1, 2.5e-19 J with 0.1 for 0.3
-#: more iterations per step). A stagnating iteration still ends by the solver's test on the correction.
-FLOOR = 0.1
+DEFAULT_NEWTON = NewtonOptions(tol=1e-15, residual_atol=0.0, contraction=0.1, max_iter=40)
 
 
-class EnergyMomentum(FixedStepIntegrator):
+class EnergyMomentum(NewtonStepper):
     """Energy-momentum (discrete-gradient midpoint) integrator; see the module docstring.
 
     Parameters
@@ -122,12 +117,16 @@ class EnergyMomentum(FixedStepIntegrator):
         translations only (linear momentum and energy exact).
     newton : NewtonOptions or dict, optional
         Default :data:`DEFAULT_NEWTON` (modified Newton, relative tolerance 1e-15, so that the
-        residual floor decides; refresh at rate 0.1; 40 iterations).
+        residual floor decides; refresh at rate 0.1; 40 iterations). The floor is
+        ``ENERGY_ROUNDOFF * eps * max|dG/dq| * max(1, max|q|)`` (:mod:`ancfdae._scale`); a
+        stagnating iteration still ends by the solver's test on the correction.
     """
 
     name = "energy-momentum"
     order = 2
     fixed_step = True
+    FLOOR_ROUNDOFF = ENERGY_ROUNDOFF
+    FLOOR_UPDATE = "replace"     # the floor of the latest Jacobian (a running maximum moved energy and flying3d)
 
     def __init__(self, model: Model, h: float, *, discrete_gradient: str = "auto", angular_momentum: bool = True,
                  newton: NewtonOptions | dict | None = None) -> None:
@@ -143,7 +142,7 @@ class EnergyMomentum(FixedStepIntegrator):
                              f"'energy-momentum'; {type(model).__name__} declares "
                              f"{sorted(capabilities(model))}.")
         super().__init__(model, h, newton=DEFAULT_NEWTON if newton is None else newton)
-        V.choice("discrete_gradient", discrete_gradient, DISCRETE_GRADIENTS)
+        validate.choice("discrete_gradient", discrete_gradient, DISCRETE_GRADIENTS)
         degree = getattr(model, "potential_degree", None)
         if discrete_gradient == "auto":
             discrete_gradient = "avf" if degree is not None else "gonzalez"
@@ -157,28 +156,36 @@ class EnergyMomentum(FixedStepIntegrator):
         self._bind(model)
 
     def _bind(self, model):
-        """Mass matrix, its factorisation and the discrete gradient of ``model``."""
+        """Mass matrix, its factorisation and the discrete gradient of ``model`` (a plain model).
+
+        The discrete gradient evaluates ``self.model``, the counting proxy (its ``potential*`` calls
+        show in the stats), which then wraps ``model``.
+        """
         self._model_bound = model
         self._M = sp.csr_matrix(model.mass(model.initial_state()[0]))
         self._Mlu = spla.splu(sp.csc_matrix(self._M))
         degree = getattr(model, "potential_degree", None)
-        evals = getattr(getattr(self, "_dg", None), "evals", 0)
-        self._dg = (AVFGradient(model, degree) if self.discrete_gradient == "avf"
-                    else GonzalezGradient(model, self._M, rotations=self.angular_momentum))
-        self._dg.evals = evals
+        self._dg = (AVFGradient(self.model, degree) if self.discrete_gradient == "avf"
+                    else GonzalezGradient(self.model, self._M, rotations=self.angular_momentum))
 
-    def _init_impl(self):
-        """The driver may have bound another model instance: use it; check the residual split."""
-        if self.model is not self._model_bound:
-            self._bind(self.model)
-        self._dg.evals = 0
+    def _setup(self):
+        """The driver may hand another model instance: bind it; check the residual split."""
+        super()._setup()
+        if self.model.wrapped is not self._model_bound:
+            self._bind(self.model.wrapped)
         self._check_split(self.t, self.q, self.v)
 
-    def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model | None = None) -> None:
-        """Carry on from a state a model event changed (grid and Newton matrix kept)."""
+    def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model) -> None:
+        """Carry on from a state a model event changed (grid and Newton matrix kept; a new model rebound).
+
+        Parameters
+        ----------
+        t, q, v, a, model
+            As for :meth:`~ancfdae.integrators.Integrator.restart`.
+        """
         super().restart(t, q, v, a, model)
-        if self.model is not self._model_bound:
-            self._bind(self.model)
+        if self.model.wrapped is not self._model_bound:
+            self._bind(self.model.wrapped)
 
     def _check_split(self, t, q, v):
         """The scheme integrates ``M a + grad P - f_nc``; refuse a model whose residual has more
@@ -202,7 +209,6 @@ class EnergyMomentum(FixedStepIntegrator):
         model, dg, M, c = self.model, self._dg, self._M, 2.0 / (h * h)
         dg.start(tm, q0)
         hv0 = h * v0
-        eps = np.finfo(float).eps
 
         # Unknown: y = q1 - q0 - h v0 (the step's deviation from the free flight, O(h^2)). Then
         # v1 - v0 = 2 y / h is formed from y, not from q1 - q0: the energy identity's error is
@@ -217,29 +223,27 @@ class EnergyMomentum(FixedStepIntegrator):
             u = hv0 + y
             _, Kf = model.nonconservative_force(tm, q0 + 0.5 * u, True)
             J = dg.jacobian(q0 + u)
-            self._n_jac += 1
-            kmax = float(np.max(np.abs(J.data if sp.issparse(J) else J), initial=0.0))
-            self.newton.residual_floor = FLOOR * eps * kmax * max(1.0, float(np.max(np.abs(q0 + u))))
+            floor = self.floor_of(J, q0 + u)      # dG/dq plays the stiffness' part
             if sp.issparse(J):
-                return sp.csr_matrix(c * M + J - 0.5 * Kf)
-            return J + (c * M - 0.5 * Kf).toarray()
+                return sp.csr_matrix(c * M + J - 0.5 * Kf), floor
+            return J + (c * M - 0.5 * Kf).toarray(), floor
 
-        out = self.newton.solve(residual, jacobian, self._predict(h))
+        out = self._solve(residual, jacobian, self._predict(h))
         if not out.converged:
-            return False, f"Newton: {out.message}"
+            return StepOutcome.failure(f"Newton: {out.message}")
         y = out.x
         q1 = q0 + (hv0 + y)
         v1 = v0 + (2.0 / h) * y
         # The acceleration at t1 (for interpolation and the next predictor): M a1 = -r(t1, q1, v1, 0).
-        a1 = self._Mlu.solve(-np.asarray(self._residual(t1, q1, v1, np.zeros_like(q1)), dtype=float))
+        a1 = self._Mlu.solve(-np.asarray(model.residual(t1, q1, v1, np.zeros_like(q1)), dtype=float))
         if not np.all(np.isfinite(a1)):
-            return False, f"the acceleration at t = {t1:.9g} is not finite (the model's residual there)"
+            return StepOutcome.failure(f"the acceleration at t = {t1:.9g} is not finite (the model's residual there)")
         quad = None
         if self.want_quadrature:
             # The scheme's own rule: midpoint state, velocity (q1 - q0)/h, weight h.
             quad = Quadrature(t=np.array([tm]), q=(q0 + 0.5 * (hv0 + y))[None, :], v=(v0 + y / h)[None, :],
                               w=np.array([h]))
-        return True, (q1, v1, a1, quad)
+        return StepOutcome(ok=True, t=t1, q=q1, v=v1, a=a1, quadrature=quad)
 
     def _predict(self, h):
         """Initial guess of ``y = q1 - q0 - h v0 = h^2 a / 2 + h^3 a' / 6 + O(h^4)``, with ``a'`` from
@@ -252,14 +256,29 @@ class EnergyMomentum(FixedStepIntegrator):
     # -- records -------------------------------------------------------------------------
     @property
     def stats(self) -> dict:
-        """Work counters since :meth:`initialize` (``potential_gradient_evals``: gradient passes)."""
+        """Work counters since :meth:`initialize`.
+
+        Newton's residual here is the discrete-gradient equation, not the model's residual: its
+        evaluations count among ``residual_evals`` beside the model's (one per step, for the
+        acceleration), and ``jacobian_evals`` are the evaluations of its matrix (a discrete
+        gradient's Jacobian). ``potential_evals`` and ``potential_gradient_evals`` count the
+        model's calls (every discrete-gradient pass, Jacobians included).
+        """
         st = super().stats
-        st["residual_evals"] = self.newton.stats.residual_evals + self._n_res
-        st["potential_gradient_evals"] = self._dg.evals
+        st["residual_evals"] = self.newton.stats.residual_evals + self.model.n_residual
+        st["jacobian_evals"] = self.newton.stats.jacobian_evals
+        st["potential_gradient_evals"] = self.model.n_potential_gradient
+        st["potential_evals"] = self.model.n_potential
         return st
 
     def options(self) -> dict:
-        """The options as a JSON-able dict."""
+        """The options as a JSON-able dict.
+
+        Returns
+        -------
+        dict
+            ``h``, the Newton options, ``discrete_gradient`` and ``angular_momentum``.
+        """
         o = super().options()
         o["discrete_gradient"] = self.discrete_gradient
         o["angular_momentum"] = self.angular_momentum

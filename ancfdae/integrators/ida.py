@@ -26,10 +26,10 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike
 
-from ancfdae import _validate as V
+from ancfdae import _validate as validate
 from ancfdae.integrators._ida_jacobian import _JacobianFiller
-from ancfdae.integrators.driver import check_model
-from ancfdae.integrators.protocol import Integrator, StepOutcome
+from ancfdae.integrators.integrator import Integrator
+from ancfdae.integrators.protocol import StepOutcome
 from ancfdae.problem import Model
 
 __all__ = ["IDA"]
@@ -114,7 +114,8 @@ class IDA(Integrator):
     Statistics: ``newton_iterations`` counts calls of the residual, which SUNDIALS' Newton
     solver evaluates exactly once per iteration (the Jacobian is ours, no difference
     quotients); ``jacobian_evals`` = ``factorizations`` counts calls of the Jacobian (each is
-    followed by one factorisation); ``reinits`` the re-initialisations after model events.
+    followed by one factorisation); both from the counting proxy of the base class.
+    ``reinits`` counts the re-initialisations after model events.
     """
 
     name = "ida"
@@ -125,9 +126,8 @@ class IDA(Integrator):
     def __init__(self, model: Model, rtol: float = 1e-6, atol: float | ArrayLike | None = None, *,
                  max_order: int = 5, max_step: float = 0.0, first_step: float = 0.0,
                  linsolver: str = "auto") -> None:
-        self.n_dof = check_model(model)
         super().__init__(model, None)
-        self.rtol = V.positive("rtol", rtol)
+        self.rtol = validate.positive("rtol", rtol)
         self.atol = atol
         if atol is not None:
             arr = np.atleast_1d(np.asarray(atol, dtype=float)) if not isinstance(atol, str) else None
@@ -138,14 +138,21 @@ class IDA(Integrator):
         if isinstance(max_order, bool) or max_order not in (1, 2, 3, 4, 5):
             raise ValueError(f"`max_order` must be an integer in [1, 5], got {max_order!r}.")
         self.max_order = int(max_order)
-        self.max_step = V.nonnegative("max_step", max_step)
-        self.first_step = V.nonnegative("first_step", first_step)
-        self.linsolver = V.choice("linsolver", linsolver, ("auto", "band", "sparse", "dense"))
+        self.max_step = validate.nonnegative("max_step", max_step)
+        self.first_step = validate.nonnegative("first_step", first_step)
+        self.linsolver = validate.choice("linsolver", linsolver, ("auto", "band", "sparse", "dense"))
         self._ls = self.linsolver if self.linsolver != "auto" else ("band" if 2 * self.n_dof <= 2000 else "sparse")
         self._solver = None
+        self._reinits = 0
 
     def options(self) -> dict:
-        """The options as a JSON-able dict."""
+        """The options as a JSON-able dict.
+
+        Returns
+        -------
+        dict
+            ``rtol``, ``atol``, ``max_order``, ``max_step``, ``first_step`` and the linear solver used.
+        """
         atol = self.atol
         if atol is not None:
             atol = np.atleast_1d(np.asarray(atol, float)).tolist()
@@ -166,7 +173,6 @@ class IDA(Integrator):
 
     # -- the first-order system in the solver's ordering -----------------------------------------
     def _resfn(self, t, y, yp, res):
-        self._n_res += 1
         n = self.n_dof
         if self._perm is None:
             res[:n] = yp[:n] - y[n:]
@@ -176,7 +182,6 @@ class IDA(Integrator):
             res[1::2] = self.model.residual(t, y[0::2], y[1::2], yp[1::2])
 
     def _jacfn(self, t, y, yp, res, cj, JJ):
-        self._n_jac += 1
         q, v, a = self._split(y, yp)
         blk = self.model.jacobian(t, q, v, a)
         if self._ls == "sparse":
@@ -196,11 +201,10 @@ class IDA(Integrator):
         return (y, yp) if self._perm is None else (y[self._perm], yp[self._perm])
 
     # -- protocol -----------------------------------------------------------------------------
-    def initialize(self, t0: float, q0: ArrayLike, v0: ArrayLike, a0: ArrayLike, t_bound: float) -> None:
-        """Set up the solver (pattern of the Jacobian at t0) and take the initial state."""
-        super().initialize(t0, q0, v0, a0, t_bound)
-        n = self.n_dof
-        self._n_res = self._n_jac = self._steps = self._reinits = 0
+    def _setup(self) -> None:
+        """Set up the solver (pattern of the Jacobian at t0) at the initial state."""
+        n, t0, q0, v0, a0 = self.n_dof, self.t, self.q, self.v, self.a
+        self._reinits = 0
         self._replay = False
         blocks0 = self.model.jacobian(t0, q0, v0, a0)
         self._filler = _JacobianFiller(blocks0, n)
@@ -225,7 +229,7 @@ class IDA(Integrator):
             if self._ls == "band":
                 bw = int(np.max(np.abs(inv[P.row] - inv[P.col])))
                 opts.update(lband=bw, uband=bw)
-        opts["atol"] = self._atol(q0, t_bound - t0)
+        opts["atol"] = self._atol(q0, self.t_bound - t0)
         with warnings.catch_warnings():
             warnings.filterwarnings("ignore", message="Custom sparse Jacobian")
             self._solver = _sundae().ida.IDA(self._resfn, **opts)
@@ -252,7 +256,6 @@ class IDA(Integrator):
         if not (np.isfinite(y).all() and np.isfinite(yp).all()):
             return StepOutcome.failure("the solution became non-finite")
         q, v, a = self._split(y, yp)
-        self._steps += 1
         return StepOutcome(ok=True, t=t_new, q=q, v=v, a=a)
 
     def interpolate(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -266,8 +269,14 @@ class IDA(Integrator):
         self._replay = True
         return self._split(np.asarray(out.y).reshape(-1), np.asarray(out.yp).reshape(-1))
 
-    def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model | None = None) -> None:
-        """Re-initialise IDA at a state changed by a model event (BDF history lost)."""
+    def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model) -> None:
+        """Re-initialise IDA at a state changed by a model event (BDF history lost).
+
+        Parameters
+        ----------
+        t, q, v, a, model
+            As for :meth:`~ancfdae.integrators.Integrator.restart` (``a`` consistent: ``consistent_restart``).
+        """
         super().restart(t, q, v, a, model)
         self._solver.init_step(float(t), *self._join(q, v, a))
         self._replay = False
@@ -276,8 +285,6 @@ class IDA(Integrator):
     @property
     def stats(self) -> dict:
         """Work counters since :meth:`initialize` (see Notes)."""
-        if self._solver is None:
-            return {}
-        return {"steps": self._steps, "newton_iterations": self._n_res, "residual_evals": self._n_res,
-                "jacobian_evals": self._n_jac, "factorizations": self._n_jac, "reinits": self._reinits,
-                "max_order": self.max_order}
+        m = self.model
+        return {"steps": self.n_steps, "newton_iterations": m.n_residual, **m.counts(),
+                "factorizations": m.n_jacobian, "reinits": self._reinits, "max_order": self.max_order}

@@ -36,15 +36,15 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ancfdae import _validate as V
+from ancfdae import _validate as validate
 from ancfdae.integrators._affine import affine2, stage_constants, stage_states
-from ancfdae.integrators._base import FixedStepIntegrator
 from ancfdae.integrators._linsolve import StageMatrix
-from ancfdae.integrators._newton import NewtonOptions
-from ancfdae.integrators.protocol import Quadrature
+from ancfdae.integrators._newton_records import NewtonOptions
+from ancfdae.integrators.newton_stepper import NewtonStepper
+from ancfdae.integrators.protocol import Quadrature, StepOutcome
 from ancfdae.problem import Model, capabilities
 
-__all__ = ["ButcherTableau", "LOBATTO_IIIA_2", "LOBATTO_IIIA_3", "LobattoIIIA"]
+__all__ = ["ButcherTableau", "LOBATTO_IIIA_2", "LOBATTO_IIIA_3", "LobattoIIIA", "Lobatto2", "Lobatto3"]
 
 
 @dataclass(frozen=True)
@@ -89,7 +89,7 @@ class ButcherTableau:
             raise ValueError("tableau entries must be finite.")
         if not np.allclose(a.sum(axis=1), c, rtol=0, atol=1e-14):
             raise ValueError(f"tableau violates c_i = sum_j a_ij: c = {c}, row sums = {a.sum(axis=1)}.")
-        V.positive_int("order", self.order)
+        validate.positive_int("order", self.order)
         for k in range(1, self.order + 1):
             if abs(b @ c ** (k - 1) - 1.0 / k) > 1e-14:
                 raise ValueError(f"tableau {self.name!r} violates the order-{self.order} quadrature condition "
@@ -133,7 +133,7 @@ def _lagrange_weights(nodes, points):
     return W
 
 
-class LobattoIIIA(FixedStepIntegrator):
+class LobattoIIIA(NewtonStepper):
     """Lobatto IIIA, fixed step, (modified) Newton on the stage accelerations.
 
     Parameters
@@ -169,7 +169,7 @@ class LobattoIIIA(FixedStepIntegrator):
             raise ValueError(f"`stages`: tableau {tab.name!r} must have an explicit first stage and be stiffly "
                              "accurate (Lobatto IIIA type).")
         self.tableau = tab
-        self.predictor = V.choice("predictor", predictor, ("extrapolate", "constant"))
+        self.predictor = validate.choice("predictor", predictor, ("extrapolate", "constant"))
         self.name = f"lobatto{tab.stages}"
         self.order = tab.order
         s = tab.stages
@@ -181,14 +181,22 @@ class LobattoIIIA(FixedStepIntegrator):
         self._perm = None
 
     def options(self) -> dict:
+        """The options as a JSON-able dict (stored in the Result).
+
+        Returns
+        -------
+        dict
+            ``h``, the Newton options, ``stages`` and ``predictor``.
+        """
         o = super().options()
         o.update(stages=self.tableau.stages, predictor=self.predictor)
         return o
 
-    def _init_impl(self):
+    def _setup(self):
+        super()._setup()
         self._prev = None  # (h, stage accelerations (n, s)) of the last step
         self._w_cache = None
-        self._stages = "residual_stages" in capabilities(self.model)
+        self._stages = "residual_stages" in capabilities(self.model)   # declared, forwarded by the proxy
 
     # -- predictor -------------------------------------------------------------------------
     def _guess(self, h):
@@ -248,7 +256,7 @@ class LobattoIIIA(FixedStepIntegrator):
 
     # -- one step ----------------------------------------------------------------------------
     def _step_impl(self, t, h):
-        m, n = self._m, self.n_dof
+        m, n, model = self._m, self.n_dof, self.model
         ts = t + self._c * h
         # Stage states are affine in X: V = V0 + X @ CV, Q = Q0 + X @ CQ (constant parts once per step).
         Q0, V0 = stage_constants(self.q, self.v, self.a, h * self._a_first, h * self._c, h * h * self._a2_first)
@@ -257,24 +265,22 @@ class LobattoIIIA(FixedStepIntegrator):
             v0, q0, cv, cq, t1 = V0[:, 0], Q0[:, 0], CV[0, 0], CQ[0, 0], ts[0]
 
             def residual(x):
-                return self._residual(t1, *affine2(q0, v0, cq, cv, x), x)
+                return model.residual(t1, *affine2(q0, v0, cq, cv, x), x)
 
             def jacobian(x):
                 qs, vs = affine2(q0, v0, cq, cv, x)
-                blk = self._jacobian(t1, qs, vs, x)
-                self._set_floor(blk, qs)
-                return self._matrix([blk], h)
+                blk = model.jacobian(t1, qs, vs, x)
+                return self._matrix([blk], h), self.floor_of(blk.K, qs)
         else:
-            stages = self.model.residual_stages if self._stages else None
+            stages = model.residual_stages if self._stages else None
 
             def residual(x):
                 Q, V_, X = stage_states(Q0, V0, CQ, CV, x)   # one compiled call for both products
                 if stages is not None:   # all stages in one model call (optional Model method)
-                    self._n_res += m
                     return stages(ts, Q, V_, X).ravel()
                 R = np.empty((n, m))
                 for i in range(m):
-                    R[:, i] = self._residual(ts[i], Q[:, i], V_[:, i], X[:, i])
+                    R[:, i] = model.residual(ts[i], Q[:, i], V_[:, i], X[:, i])
                 return R.ravel()
 
             eigen = [self.newton.options.jacobian == "modified"]
@@ -284,28 +290,28 @@ class LobattoIIIA(FixedStepIntegrator):
                 if eigen[0]:
                     # Modified Newton reuses the matrix across steps anyway: one set of blocks (at
                     # the last stage) lets the stage system split in the tableau's eigenbasis.
-                    blk = self._jacobian(ts[-1], Q[:, -1], V_[:, -1], X[:, -1])
-                    self._set_floor(blk, Q[:, -1])
+                    blk = model.jacobian(ts[-1], Q[:, -1], V_[:, -1], X[:, -1])
+                    floor = self.floor_of(blk.K, Q[:, -1])
                     if blk.same_pattern:
-                        return StageMatrix(blk, h, self._a_rest)
-                    blocks = [blk if i == m - 1 else self._jacobian(ts[i], Q[:, i], V_[:, i], X[:, i])
+                        return StageMatrix(blk, h, self._a_rest), floor
+                    blocks = [blk if i == m - 1 else model.jacobian(ts[i], Q[:, i], V_[:, i], X[:, i])
                               for i in range(m)]
-                    return self._matrix(blocks, h)
-                blocks = [self._jacobian(ts[i], Q[:, i], V_[:, i], X[:, i]) for i in range(m)]
-                for i, blk in enumerate(blocks):
-                    self._set_floor(blk, Q[:, i])
-                return self._matrix(blocks, h)
+                    return self._matrix(blocks, h), floor
+                blocks = [model.jacobian(ts[i], Q[:, i], V_[:, i], X[:, i]) for i in range(m)]
+                # the residual holds every stage: the floor of the largest
+                floor = max(self.floor_of(blk.K, Q[:, i]) for i, blk in enumerate(blocks))
+                return self._matrix(blocks, h), floor
 
         guess = self._guess(h).ravel()
-        out = self.newton.solve(residual, jacobian, guess)
+        out = self._solve(residual, jacobian, guess)
         if not out.converged and m > 1 and eigen[0]:
             # The one-state eigenbasis matrix can be too crude where the stages differ much (large
             # steps, strong nonlinearity): before failing, retry the step with the exact per-stage matrix.
             eigen[0] = False
             self.newton.invalidate()
-            out = self.newton.solve(residual, jacobian, guess)
+            out = self._solve(residual, jacobian, guess)
         if not out.converged:
-            return False, f"Newton: {out.message}"
+            return StepOutcome.failure(f"Newton: {out.message}")
         Q, V_, X = stage_states(Q0, V0, CQ, CV, out.x)
         if self.predictor == "extrapolate":
             self._prev = (h, np.column_stack([self.a, X]))
@@ -313,4 +319,33 @@ class LobattoIIIA(FixedStepIntegrator):
         if self.want_quadrature:  # the step's Lobatto quadrature, for monitors that integrate over it
             quad = Quadrature(np.r_[t, ts], np.column_stack([self.q, Q]).T, np.column_stack([self.v, V_]).T,
                               h * self.tableau.b)
-        return True, (Q[:, -1].copy(), V_[:, -1].copy(), X[:, -1].copy(), quad)
+        return StepOutcome(ok=True, t=t + h, q=Q[:, -1].copy(), v=V_[:, -1].copy(), a=X[:, -1].copy(),
+                           quadrature=quad)
+
+
+class _FixedStages(LobattoIIIA):
+    """Lobatto IIIA with the class's number of stages (``STAGES``): a key of ``ancfdae.METHODS``."""
+
+    STAGES = 3
+
+    def __init__(self, model: Model, h: float, *, newton: NewtonOptions | dict | None = None,
+                 predictor: str = "constant") -> None:
+        super().__init__(model, h, self.STAGES, newton=newton, predictor=predictor)
+
+
+class Lobatto3(_FixedStages):
+    """Lobatto IIIA with 3 stages (order 4; the chapter's integrator), ``METHODS["lobatto3"]``.
+
+    Takes the arguments of :class:`LobattoIIIA` but ``stages``.
+    """
+
+    name, STAGES = "lobatto3", 3
+
+
+class Lobatto2(_FixedStages):
+    """Lobatto IIIA with 2 stages (trapezoidal rule, order 2), ``METHODS["lobatto2"]``.
+
+    Takes the arguments of :class:`LobattoIIIA` but ``stages``.
+    """
+
+    name, STAGES = "lobatto2", 2

@@ -30,8 +30,9 @@ from __future__ import annotations
 import numbers
 
 from ancfdae.integrators._affine import affine2, affine3, newmark_predict
-from ancfdae.integrators._base import FixedStepIntegrator
-from ancfdae.integrators._newton import NewtonOptions
+from ancfdae.integrators._newton_records import NewtonOptions
+from ancfdae.integrators.newton_stepper import NewtonStepper
+from ancfdae.integrators.protocol import StepOutcome
 from ancfdae.problem import Model
 
 __all__ = ["Newmark", "HHTAlpha", "GeneralizedAlpha"]
@@ -43,7 +44,7 @@ def _param(name, value, low, high):
     return float(value)
 
 
-class _AlphaFamily(FixedStepIntegrator):
+class _AlphaFamily(NewtonStepper):
     """The shared generalized-alpha step (parameters validated by the subclasses)."""
 
     order = 2
@@ -53,12 +54,19 @@ class _AlphaFamily(FixedStepIntegrator):
         self.beta, self.gamma, self.alpha_m, self.alpha_f = beta, gamma, alpha_m, alpha_f
 
     def options(self) -> dict:
+        """The options as a JSON-able dict (stored in the Result).
+
+        Returns
+        -------
+        dict
+            ``h``, the Newton options and the four parameters of the scheme.
+        """
         o = super().options()
         o.update(beta=self.beta, gamma=self.gamma, alpha_m=self.alpha_m, alpha_f=self.alpha_f)
         return o
 
     def _step_impl(self, t, h):
-        am, af, b, g = self.alpha_m, self.alpha_f, self.beta, self.gamma
+        am, af, b, g, model = self.alpha_m, self.alpha_f, self.beta, self.gamma, self.model
         ta = t + (1.0 - af) * h
         # q_{n+1}, v_{n+1} and the weighted state are affine in x = a_{n+1}: their constant parts
         # once per step, in one compiled pass (as NumPy each operation costs ~1 us at these sizes).
@@ -68,19 +76,19 @@ class _AlphaFamily(FixedStepIntegrator):
 
         # one compiled call forms the three weighted states (bit-for-bit the NumPy expressions)
         def residual(x):
-            return self._residual(ta, *affine3(qa0, va0, aa0, cqa, cva, caa, x))
+            return model.residual(ta, *affine3(qa0, va0, aa0, cqa, cva, caa, x))
 
         def jacobian(x):
             qa, va, aa = affine3(qa0, va0, aa0, cqa, cva, caa, x)
-            J = self._jacobian(ta, qa, va, aa)
-            self._set_floor(J, qa)
-            return J.combine(cqa, cva, caa)
+            J = model.jacobian(ta, qa, va, aa)
+            return J.combine(cqa, cva, caa), self.floor_of(J.K, qa)
 
-        out = self.newton.solve(residual, jacobian, self.a)
+        out = self._solve(residual, jacobian, self.a)
         if not out.converged:
-            return False, f"Newton: {out.message}"
+            return StepOutcome.failure(f"Newton: {out.message}")
         x = out.x
-        return True, (*affine2(q_pred, v_pred, cq, cv, x), x, None)
+        q, v = affine2(q_pred, v_pred, cq, cv, x)
+        return StepOutcome(ok=True, t=t + h, q=q, v=v, a=x)
 
 
 class Newmark(_AlphaFamily):
@@ -132,6 +140,13 @@ class HHTAlpha(_AlphaFamily):
         self.alpha = alpha
 
     def options(self) -> dict:
+        """The options as a JSON-able dict (stored in the Result).
+
+        Returns
+        -------
+        dict
+            Those of the family and ``alpha``.
+        """
         o = super().options()
         o["alpha"] = self.alpha
         return o
@@ -163,6 +178,13 @@ class GeneralizedAlpha(_AlphaFamily):
         self.rho_inf = rho
 
     def options(self) -> dict:
+        """The options as a JSON-able dict (stored in the Result).
+
+        Returns
+        -------
+        dict
+            Those of the family and ``rho_inf``.
+        """
         o = super().options()
         o["rho_inf"] = self.rho_inf
         return o

@@ -1,59 +1,26 @@
-"""The integrator protocol: what a time stepper implements, and what the driver does for it.
+"""The stepper protocol: what a time stepper offers the driver, and what one step returns.
 
 An integrator of ancfdae is a *stepper*: it advances the state of a Model (``ancfdae.problem``)
 one step at a time. Everything around the steps -- validation of the arguments, the consistent
 initial acceleration, output times, monitors, hooks, model events (BE3D's director update),
 failure handling and the :class:`~ancfdae.result.Result` -- belongs to one driver loop
-(:func:`ancfdae.simulate`), so that our integrators and a user's own behave alike.
-
-A stepper implements
-
-``initialize(t0, q0, v0, a0, t_bound)``
-    take the initial state (``a0`` is the consistent acceleration the driver computed) and the
-    end of the run; no step is taken yet;
-``step() -> StepOutcome``
-    advance one step from the current state. On success the outcome carries the new state
-    (and, optionally, the step's quadrature nodes for monitors that integrate over the step);
-    on failure ``ok`` is False, ``message`` says why, and the stepper's state is unchanged;
-``interpolate(t) -> (q, v, a)``
-    the state at a time inside the last step (default: quintic Hermite through ``(q, v, a)`` at
-    the step's ends; a stepper with its own dense output overrides it);
-``accept(outcome)``
-    make a successful step's state the current one (the driver calls it; the base class keeps
-    the previous state for :meth:`interpolate`);
-``restart(t, q, v, a, model)``
-    continue from a state that a model event changed (the driver passes the model bound to the
-    event's new state); multistep methods drop their history. ``a`` is an acceleration
-    recomputed consistently with the new state when the class sets ``consistent_restart = True``
-    (IDA), else the step's own (one-step methods carry on);
-``stats`` and ``options()``
-    counters since ``initialize`` and the options as a JSON-able dict (both stored in the Result).
-
-Class attributes: ``name`` (the key of :data:`ancfdae.METHODS` or a user's label), ``order``
-(the classical order, or None), ``fixed_step`` (True when the constructor takes the step
-size ``h``) and ``consistent_restart``.
-
-Before ``initialize`` the driver sets two attributes: ``model`` (the model bound to the run's
-initial event state; a stepper must evaluate ``self.model``, never a model it kept elsewhere) and
-``want_quadrature`` (True when monitors will use the step's quadrature; a stepper may skip
-building it otherwise). The driver also checks the model's declared capabilities
-(:func:`ancfdae.problem.capabilities`); a stepper uses a fast path only when it is declared.
-:meth:`Integrator.run` runs a constructed stepper through the same driver.
+(:func:`ancfdae.integrators.driver.integrate`), so that our integrators and a user's own behave
+alike. This module holds only the contract between the two: :class:`Stepper` (what the driver
+calls), :class:`StepOutcome` (what a step returns) and :class:`Quadrature` (a step's own rule, for
+monitors). The base classes that implement it are :class:`~ancfdae.integrators.Integrator` (every
+stepper), :class:`~ancfdae.integrators.FixedStepIntegrator` (the uniform grid) and
+:class:`~ancfdae.integrators.NewtonStepper` (a Newton solve per step).
 """
 from __future__ import annotations
 
-from abc import ABC, abstractmethod
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, NamedTuple
+from typing import NamedTuple, Protocol, runtime_checkable
 
 import numpy as np
 
 from ancfdae.problem import Model
 
-if TYPE_CHECKING:                       # the result module imports the integrators
-    from ancfdae.result import Result
-
-__all__ = ["Quadrature", "StepOutcome", "Integrator"]
+__all__ = ["Quadrature", "StepOutcome", "Stepper"]
 
 
 class Quadrature(NamedTuple):
@@ -77,14 +44,15 @@ class Quadrature(NamedTuple):
 
 @dataclass(frozen=True)
 class StepOutcome:
-    """What one call of :meth:`Integrator.step` returns.
+    """What one step returns: the one outcome type of the stepper layer.
 
     Attributes
     ----------
     ok : bool
         False when the step failed; then only ``message`` is meaningful.
     t : float
-        Time reached.
+        Time reached. A fixed-step method may leave it unset: its base puts the outcome at the
+        grid time.
     q, v, a : ndarray, shape (n_dof,)
         The new state (``a`` is the method's acceleration at ``t``).
     quadrature : Quadrature or None
@@ -102,82 +70,81 @@ class StepOutcome:
     message: str = ""
 
     @classmethod
-    def failure(cls, message: str) -> "StepOutcome":
-        """A failed step with its reason."""
+    def failure(cls, message: str) -> StepOutcome:
+        """A failed step with its reason.
+
+        Parameters
+        ----------
+        message : str
+            Why the step failed.
+
+        Returns
+        -------
+        StepOutcome
+            ``ok`` False.
+        """
         return cls(ok=False, message=str(message))
 
 
-class Integrator(ABC):
-    """Base class of the steppers; see the module docstring for the protocol.
+@runtime_checkable
+class Stepper(Protocol):
+    """What the driver calls, in this order: ``initialize``, then ``step`` and ``accept`` per step.
 
-    Subclasses set ``name``, ``order`` and ``fixed_step``, take ``model`` as the first argument
-    of their constructor (and ``h`` as the second when ``fixed_step``), and implement
-    :meth:`step`. The base class keeps the current state (``t, q, v, a``) and the previous one,
-    and provides :meth:`initialize`, :meth:`interpolate` and :meth:`restart`.
-
-    Parameters
+    Attributes
     ----------
-    model : Model
-        The equations of motion.
-    h : float, optional
-        Step size of a fixed-step method (None for adaptive ones).
+    name : str
+        The label stored in ``Result.method``.
+    fixed_step : bool
+        True when the constructor takes a step size ``h``.
+    h : float or None
+        The step size of a fixed-step method.
+    consistent_restart : bool
+        True when a restart after a model event needs an acceleration consistent with the changed
+        state (IDA); else the step's own is passed.
+    t : float
+        The current time (after ``initialize``).
+    q, v, a : ndarray
+        The current state.
+    stats : dict
+        Work counters since ``initialize``, at least ``steps``; the driver adds its own keys
+        (``model_events``, ``restarts``, ``wall_time``, ``cpu_time``) and never overwrites these.
     """
 
-    name: str = "integrator"
-    order: int | None = None
-    fixed_step: bool = True
-    consistent_restart: bool = False
-    want_quadrature: bool = False
+    name: str
+    fixed_step: bool
+    h: float | None
+    consistent_restart: bool
+    t: float
+    q: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
 
-    def __init__(self, model: Model, h: float | None = None) -> None:
-        self.model = model
-        self.h = h
-
-    # -- state ---------------------------------------------------------------------------
-    def initialize(self, t0: float, q0: np.ndarray, v0: np.ndarray, a0: np.ndarray,
-                   t_bound: float) -> None:
-        """Take the initial state and the end time of the run."""
-        self.t, self.q, self.v, self.a = float(t0), q0, v0, a0
-        self.t_bound = float(t_bound)
-        self.previous = None
-
-    def accept(self, outcome: StepOutcome) -> None:
-        """Make ``outcome`` the current state (the driver calls this after a successful step)."""
-        self.previous = (self.t, self.q, self.v, self.a)
-        self.t, self.q, self.v, self.a = outcome.t, outcome.q, outcome.v, outcome.a
-
-    @abstractmethod
-    def step(self) -> StepOutcome:
-        """Advance one step from the current state; must not change the state."""
-
-    def interpolate(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """State at ``t`` inside the last step (quintic Hermite through both ends)."""
-        from ancfdae.integrators._hermite import hermite5  # noqa: PLC0415 - small helper module
-        t0, q0, v0, a0 = self.previous
-        return hermite5(t0, (q0, v0, a0), self.t, (self.q, self.v, self.a), t)
-
-    def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model | None = None) -> None:
-        """Continue from a state changed by a model event (history is dropped)."""
-        if model is not None:
-            self.model = model
-        self.t, self.q, self.v, self.a = float(t), q, v, a
-        self.previous = None
-
-    # -- records -------------------------------------------------------------------------
     @property
     def stats(self) -> dict:
-        """Work counters since :meth:`initialize` (at least ``steps``)."""
-        return {}
+        """Work counters since ``initialize``."""
+        ...
+
+    def initialize(self, model: Model, t0: float, q0: np.ndarray, v0: np.ndarray, a0: np.ndarray,
+                   t_bound: float, *, want_quadrature: bool = False) -> None:
+        """Take the model to evaluate, the initial state (``a0`` consistent) and the end of the run."""
+        ...
+
+    def step(self) -> StepOutcome:
+        """Advance one step from the current state without changing it."""
+        ...
+
+    def accept(self, outcome: StepOutcome) -> None:
+        """Make a successful step's state the current one."""
+        ...
+
+    def interpolate(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(q, v, a)`` at ``t`` inside the last step."""
+        ...
+
+    def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model) -> None:
+        """Continue from a state a model event changed, evaluating ``model`` (bound to the new event state)."""
+        ...
 
     def options(self) -> dict:
-        """The integrator's options as a JSON-able dict."""
-        return {"h": self.h} if self.fixed_step else {}
-
-    def run(self, t_span: tuple[float, float], **kwargs: Any) -> Result:
-        """Integrate ``self.model`` over ``t_span`` through the driver.
-
-        Keyword arguments are those of :func:`ancfdae.simulate` without ``method``, ``h`` and the
-        integrator's options (``t_eval, monitors, hooks, q0, v0, state0, max_steps, progress``).
-        """
-        from ancfdae.integrators.driver import integrate  # noqa: PLC0415 - the driver imports this module
-        return integrate(self, self.model, t_span, **kwargs)
+        """The options as a JSON-able dict (stored in the Result)."""
+        ...
