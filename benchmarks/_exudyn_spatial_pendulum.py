@@ -32,8 +32,8 @@ import math
 import numpy as np
 
 from ancfdae._validate import positive, positive_int
-from ancfdae.models._quadrature import gauss_for_order
-from ancfdae.models._shapes import hermite
+from ancfdae._quadrature import gauss_for_order
+from ancfdae.models.shapes import hermite
 
 from ._exudyn_base import _exu, _ii, _require
 

@@ -16,7 +16,7 @@ every step: the model is wrapped so that ``T + U`` is evaluated just before
 and just after each update; the sum of these jumps is energy that the update
 itself puts into or takes out of the discrete system -- between updates
 BE3D's semi-discrete equations derive from one Lagrangian and conserve
-energy (see ``ancfdae/models/_be3d_dynamics.py``). Divided by the number of
+energy (see ``ancfdae/models/thin/be3d_directors.py``). Divided by the number of
 updates it is the energy injected per director update. (The
 ``"energy-momentum"`` integrator, which would leave the updates as the only
 source of a balance error, needs a constant mass matrix; BE3D's is not.)

@@ -17,7 +17,7 @@ same element arrays. See :func:`ancfdae.models.thin.be2d_numba.be2d_fused` for t
 
 numba's on-disk cache is keyed on the source file of the cached function only, and a fused entry
 point holds a compiled copy of the kernel it calls: after editing a kernel in another file, delete the
-``*.nbi``/``*.nbc`` files in ``ancfdae/models/__pycache__`` (a fresh install has no stale cache).
+``*.nbi``/``*.nbc`` files in ``ancfdae/models/beam/__pycache__`` (a fresh install has no stale cache).
 """
 from __future__ import annotations
 

@@ -23,7 +23,7 @@ after editing a function in another file (:mod:`ancfdae.models.jets.vector_numba
 :mod:`.structural_numba`, :mod:`.continuum_numba`), delete the
 ``*.nbi``/``*.nbc`` files in the ``__pycache__`` folders, or the old code keeps
 running (measured: a stale cache kept running the previous SQ tangent, which
-``tests/test_fused_assembly.py`` caught as a fused/NumPy-assembly mismatch;
+``tests/models/beam/test_fused_assembly.py`` caught as a fused/NumPy-assembly mismatch;
 the same holds for :mod:`.moment_numba`).
 """
 from __future__ import annotations

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from ancfdae.problem import Model
-from toy_models import DoublePendulum, SpringChain
+from support.toy_models import DoublePendulum, SpringChain
 
 
 def _models():

@@ -11,7 +11,7 @@ import pytest
 
 from ancfdae import Material, RectangularSection
 from ancfdae.models import BE3D, Beam, Cable3D
-from conftest import fd_gradient, rel_err
+from support.numerics import fd_gradient, rel_err
 
 FLAT = RectangularSection(0.1, 0.05)    # I3 = 4 I2
 STEEL = Material(2.07e11, 0.3, 7800.0)

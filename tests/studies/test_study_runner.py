@@ -11,13 +11,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import study_toy
+from support import study_toy
 from ancfdae.result import Result
 from ancfdae.studies import _cli
 from ancfdae.studies._common import Case, output_dir, run_cases
 
-HERE = Path(__file__).parent
-_MAIN = "import sys, study_toy; from ancfdae.studies import _cli; sys.exit(_cli.main(study_toy, sys.argv[1:]))"
+HERE = Path(__file__).resolve().parents[1]   # tests/: the folder that holds the support package
+_MAIN = "import sys; from support import study_toy; from ancfdae.studies import _cli; sys.exit(_cli.main(study_toy, sys.argv[1:]))"
 # A terminal's Ctrl-C: the child gets Python's SIGINT handler even when the test session itself runs in the
 # background (where the shell made SIGINT ignored, and children inherit that)
 _CTRL_C = "import signal; signal.signal(signal.SIGINT, signal.default_int_handler); " + _MAIN

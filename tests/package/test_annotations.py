@@ -2,7 +2,7 @@
 
 Catches: a new public function or method (or a new argument of an existing one) added without a type
 annotation, so that ``py.typed`` would promise types the package does not give to a type checker or an IDE.
-Walks the same public names as ``tests/test_docstrings.py`` and, for classes, their public methods and
+Walks the same public names as ``tests/package/test_docstrings.py`` and, for classes, their public methods and
 properties, including those inherited from the package's own mixins and base classes.
 """
 import inspect

@@ -11,7 +11,7 @@ import pytest
 pytest.importorskip("exudyn", reason="exudyn is not installed (pip install '.[benchmark]')")
 # benchmarks/ is a folder of the repository, not part of the installed package: reach it from the
 # checkout (appended, so an installed ancfdae keeps precedence over the source tree).
-sys.path.append(str(pathlib.Path(__file__).resolve().parents[1]))
+sys.path.append(str(pathlib.Path(__file__).resolve().parents[2]))
 from benchmarks import _exudyn_slider_crank as crank  # noqa: E402
 from benchmarks import _exudyn_spinup as spin  # noqa: E402
 

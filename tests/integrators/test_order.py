@@ -9,7 +9,7 @@ import pytest
 
 from ancfdae import simulate
 from ancfdae.integrators import NewtonOptions
-from toy_models import DoublePendulum
+from support.toy_models import DoublePendulum
 
 T = 1.0
 NEWTON = NewtonOptions(tol=1e-13, residual_atol=0.0)

@@ -8,7 +8,7 @@ from ancfdae import METHODS, EnergyMonitor, Material, PointForce, Probe, Rectang
 from ancfdae.integrators import FixedStepIntegrator, StepOutcome
 from ancfdae.models import BE2D, Beam
 from ancfdae.problem import capabilities
-from toy_models import DoublePendulum, NaNAfter, SpringChain
+from support.toy_models import DoublePendulum, NaNAfter, SpringChain
 
 
 class SymplecticEuler(FixedStepIntegrator):

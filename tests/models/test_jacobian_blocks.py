@@ -15,7 +15,7 @@ import pytest
 
 from ancfdae import PointForce, PointMoment, RectangularSection
 from ancfdae.models import BE2D, BE3D, SQ2D, SQ3D, Beam, Cable3D
-from conftest import fd_gradient, rel_err
+from support.numerics import fd_gradient, rel_err
 
 FLAT = RectangularSection(0.1, 0.05)
 

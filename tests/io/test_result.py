@@ -11,7 +11,7 @@ from ancfdae import EnergyMonitor, Gravity, Material, PointSensor, RectangularSe
 from ancfdae import _resultfile
 from ancfdae.export import beam_of
 from ancfdae.models import BE2D, BE3D, SQ2D, SQ3D, Beam, Cable3D
-from toy_models import SpringChain
+from support.toy_models import SpringChain
 
 SOFT = Material(E=1e6, nu=0.3, rho=1000.0)
 SEC = RectangularSection(0.1)
@@ -218,7 +218,7 @@ def test_damaged_content_is_a_clear_error(saved, tmp_path):
 #: (format ancfdae.Result/2): BE3D, 2 elements clamped at node 0, gravity and a tip moment (0, 0, 0.5),
 #: E = 1e6, nu = 0.3, rho = 1000, square 0.1; lobatto3, h = 0.005 over [0, 0.02]; monitors
 #: EnergyMonitor(), PointSensor(s=1.0) and Probe("tip_q", the last three coordinates).
-OLD_FILE = Path(__file__).parent / "data" / "result_format2_be3d.nc"
+OLD_FILE = Path(__file__).resolve().parents[1] / "data" / "result_format2_be3d.nc"
 
 
 def test_a_file_written_by_earlier_code_loads_and_is_written_again_identically(tmp_path):

@@ -10,7 +10,7 @@ import io
 import re
 from pathlib import Path
 
-PAGE = Path(__file__).resolve().parents[1] / "docs" / "own_integrator.md"
+PAGE = Path(__file__).resolve().parents[2] / "docs" / "own_integrator.md"
 
 
 def _blocks(text):

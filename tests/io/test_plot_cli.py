@@ -113,7 +113,7 @@ def test_python_dash_m(tmp_path):
 def test_no_backend_switch_in_library_or_studies():
     """A notebook user's backend survives importing and plotting: no matplotlib.use anywhere."""
     from pathlib import Path
-    root = Path(__file__).resolve().parents[1]
+    root = Path(__file__).resolve().parents[2]
     hits = [str(p.relative_to(root)) for base in ("ancfdae", "studies") for p in (root / base).rglob("*.py")
             if "matplotlib.use(" in p.read_text()]
     assert not hits, f"matplotlib.use in {hits}"

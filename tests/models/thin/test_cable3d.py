@@ -5,7 +5,7 @@ import pytest
 from ancfdae import PointForce, PointMoment, RectangularSection, solve_static
 from ancfdae.models import BE2D, Beam, Cable3D
 from test_be2d import TABLE2_RTOL
-from conftest import fd_gradient, rel_err
+from support.numerics import fd_gradient, rel_err
 
 REF_BE = np.array([-0.50853730436, 1.20723985455, 0.0])   # chapter Eq. 113
 TABLE2_BE2D = {2: 3.755e-2, 4: 2.035e-3, 8: 5.060e-5, 16: 1.202e-6, 32: 3.876e-8, 64: 1.820e-9}

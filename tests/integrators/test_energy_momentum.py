@@ -11,7 +11,7 @@ from ancfdae import Material, PointForce, PointMoment, RectangularSection, hat, 
 from ancfdae.integrators._discrete_gradient import AVFGradient, GonzalezGradient
 from ancfdae.integrators.energy_momentum import EnergyMomentum
 from ancfdae.monitors import EnergyMonitor
-from toy_models import SpringChain
+from support.toy_models import SpringChain
 
 MAT = Material(E=1e5, nu=0.3, rho=2500.0)
 SEC = RectangularSection(0.05)

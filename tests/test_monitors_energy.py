@@ -12,7 +12,7 @@ import pytest
 from ancfdae import EnergyMonitor, Material, PointForce, PointMoment, PointSensor, RectangularSection, simulate
 from ancfdae.loads import pulse
 from ancfdae.models import BE2D, Beam
-from toy_models import SpringChain
+from support.toy_models import SpringChain
 
 T_LOAD, T_END = 2.5, 3.5
 T_EVAL = np.linspace(0.0, T_END, 71)

@@ -17,7 +17,7 @@ from numpydoc.docscrape import ClassDoc, FunctionDoc
 
 import ancfdae
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 MODULES = ["ancfdae", "ancfdae.models", "ancfdae.integrators", "ancfdae.export", "ancfdae.plot", "ancfdae.cli"]
 # Dataclass-generated and protocol plumbing that carries no documentation of its own.
 SKIP_METHODS = {"__init__", "__post_init__", "__repr__"}

@@ -4,7 +4,7 @@ import pytest
 
 from ancfdae import CircularSection, RectangularSection
 from ancfdae.models import SQ2D, SQ3D, Beam
-from conftest import assert_forces_and_tangent_fd, fd_gradient, rel_err
+from support.numerics import assert_forces_and_tangent_fd, fd_gradient, rel_err
 
 FORMULATIONS = ["structural", "continuum", "continuum-locking"]
 

@@ -41,7 +41,22 @@ class _Assembler:
         return sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))
 
 
-class SpringChain:
+class _RecordsAcceptedSteps:
+    """The step-event hooks of the contract, doing nothing but record each accepted step's time in
+    ``self.accepted`` (the driver must call ``step_event`` once per accepted step, never for a rejected one)."""
+
+    def event_state(self):
+        return {}
+
+    def bind(self, state):
+        return self
+
+    def step_event(self, t, q, v):
+        self.accepted.append(t)
+        return None
+
+
+class SpringChain(_RecordsAcceptedSteps):
     """N point masses in the plane; spring i joins mass i-1 (or the hinge at the origin) and mass i."""
 
     mass_is_constant = True
@@ -160,18 +175,8 @@ class SpringChain:
         th = s - i
         return (1 - th) * P[i] + th * P[i + 1]
 
-    def event_state(self):
-        return {}
 
-    def bind(self, state):
-        return self
-
-    def step_event(self, t, q, v):
-        self.accepted.append(t)
-        return None
-
-
-class DoublePendulum:
+class DoublePendulum(_RecordsAcceptedSteps):
     """Double pendulum in absolute angles (from the downward vertical); M depends on q."""
 
     mass_is_constant = False
@@ -223,16 +228,6 @@ class DoublePendulum:
     def tip(self, q):
         return np.array([self.l1 * np.sin(q[0]) + self.l2 * np.sin(q[1]),
                          -self.l1 * np.cos(q[0]) - self.l2 * np.cos(q[1])])
-
-    def event_state(self):
-        return {}
-
-    def bind(self, state):
-        return self
-
-    def step_event(self, t, q, v):
-        self.accepted.append(t)
-        return None
 
 
 class NaNAfter:

@@ -9,7 +9,7 @@ from scipy.integrate import solve_ivp
 pytest.importorskip("exudyn", reason="exudyn is not installed (pip install '.[benchmark]')")
 # benchmarks/ is a folder of the repository, not part of the installed package: reach it from the
 # checkout (appended, so an installed ancfdae keeps precedence over the source tree).
-sys.path.append(str(pathlib.Path(__file__).resolve().parents[1]))
+sys.path.append(str(pathlib.Path(__file__).resolve().parents[2]))
 from benchmarks import _exudyn_peer as peer  # noqa: E402
 
 if not peer.available():

@@ -4,7 +4,7 @@ import pytest
 
 from ancfdae import Material, PointForce, PointMoment, RectangularSection, solve_static
 from ancfdae.models import BE2D, Beam
-from conftest import fd_gradient, rel_err
+from support.numerics import fd_gradient, rel_err
 
 REF_BE = np.array([-0.50853730436, 1.20723985455])   # chapter Eq. 113, BE2D/BE3D
 # chapter Table 2, BE2D column: elements -> tip error

@@ -5,7 +5,7 @@ import pytest
 from ancfdae import EnergyMonitor, PointSensor, Probe, simulate
 from ancfdae.integrators._hermite import hermite5
 from ancfdae.integrators import IDA, GeneralizedAlpha, LobattoIIIA, Newmark, NewtonOptions
-from toy_models import DoublePendulum, NaNAfter, SpringChain
+from support.toy_models import DoublePendulum, NaNAfter, SpringChain
 
 # (method, options): every integrator of the registry, with the step it needs
 CASES = [

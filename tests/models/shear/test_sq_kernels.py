@@ -8,7 +8,7 @@ import pytest
 
 from ancfdae import RectangularSection
 from ancfdae.models import SQ2D, SQ3D, Beam
-from conftest import assert_forces_and_tangent_fd, rel_err
+from support.numerics import assert_forces_and_tangent_fd, rel_err
 
 pytest.importorskip("numba")
 

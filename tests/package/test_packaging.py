@@ -9,7 +9,7 @@ import pytest
 import ancfdae.studies
 import ancfdae.studies.cantilever
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 tomllib = pytest.importorskip("tomllib", reason="tomllib is in the standard library from Python 3.11")
 
 

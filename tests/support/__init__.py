@@ -1,0 +1,1 @@
+"""Helpers of the test suite: finite differences (numerics), toy models, a toy study."""
