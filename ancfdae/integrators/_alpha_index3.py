@@ -33,7 +33,7 @@ import scipy.sparse as sp
 
 from ancfdae.integrators.protocol import StepOutcome
 
-__all__ = ["index3_step", "mass_scale"]
+__all__ = ["index3_step", "index3_equations", "mass_scale"]
 
 
 def mass_scale(M) -> float:
@@ -42,12 +42,9 @@ def mass_scale(M) -> float:
     return float(np.mean(np.abs(d))) if d.size else 1.0
 
 
-def index3_step(st, t: float, h: float) -> StepOutcome:
-    """One Arnold-Bruls step of the stepper ``st`` (a ``_AlphaFamily`` with ``_ah``, ``lam``, ``_mscale``).
-
-    Returns the outcome with the true acceleration ``a1`` and ``lam1``; ``st._ah_next`` holds ``ah1`` for
-    :meth:`accept`.
-    """
+def index3_equations(st, t: float, h: float):
+    """The step's Newton system: ``(residual, jacobian, x0, state)`` for the stepper ``st`` (a
+    ``_AlphaFamily`` with ``_ah``, ``lam``, ``_mscale``); ``state(x) -> (q1, v1, a1, lam1)``."""
     am, af, b, g = st.alpha_m, st.alpha_f, st.beta, st.gamma
     model, n = st.model, st.q.size
     t1 = t + h
@@ -56,7 +53,7 @@ def index3_step(st, t: float, h: float) -> StepOutcome:
     v_pred = v0 + (h * (1.0 - g)) * ah0
     s = (1.0 - am) / ((1.0 - af) * b * h * h)
     sm = s * st._mscale
-    c_ah, c_v = 1.0 / (b * h * h), g / (b * h)
+    c_v = g / (b * h)
     const_a = (am * ah0 - af * a0) / (1.0 - af)
 
     def state(x):
@@ -81,11 +78,17 @@ def index3_step(st, t: float, h: float) -> StepOutcome:
         mat = sp.bmat([[A, sm * G.T], [sm * G, sp.csr_matrix((m, m))]], format="csr")
         return mat, st.floor_of(J.K, q1)
 
-    mu0 = st.lam / sm
-    x0 = np.concatenate([(b * h * h) * ah0, mu0])
+    x0 = np.concatenate([(b * h * h) * ah0, st.lam / sm])
+    return residual, jacobian, x0, state
+
+
+def index3_step(st, t: float, h: float) -> StepOutcome:
+    """One Arnold-Bruls step of the stepper ``st``: the outcome with the true acceleration ``a1`` and
+    ``lam1``; ``st._ah_next`` holds ``ah1`` for its ``accept``."""
+    residual, jacobian, x0, state = index3_equations(st, t, h)
     out = st._solve(residual, jacobian, x0)
     if not out.converged:
         return StepOutcome.failure(f"Newton (index 3): {out.message}")
     q1, v1, a1, lam1 = state(out.x)
-    st._ah_next = c_ah * out.x[:n]
-    return StepOutcome(ok=True, t=t1, q=q1, v=v1, a=a1, lam=lam1)
+    st._ah_next = out.x[:q1.size] / (st.beta * h * h)
+    return StepOutcome(ok=True, t=t + h, q=q1, v=v1, a=a1, lam=lam1)

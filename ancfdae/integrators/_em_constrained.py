@@ -33,11 +33,12 @@ import scipy.sparse as sp
 
 from ancfdae.integrators.protocol import Quadrature, StepOutcome
 
-__all__ = ["constrained_em_step"]
+__all__ = ["constrained_em_step", "constrained_em_equations"]
 
 
-def constrained_em_step(st, t0: float, h: float) -> StepOutcome:
-    """One step of ``st`` (an :class:`~ancfdae.integrators.EnergyMomentum` on a constrained model)."""
+def constrained_em_equations(st, t0: float, h: float):
+    """The step's Newton system ``(residual, jacobian, x0)`` for ``st`` (an
+    :class:`~ancfdae.integrators.EnergyMomentum` on a constrained model); ``x = [y, mu]``."""
     q0, v0 = st.q, st.v
     tm, t1 = t0 + 0.5 * h, t0 + h
     model, dg, M, c = st.model, st._dg, st._M, 2.0 / (h * h)
@@ -73,11 +74,19 @@ def constrained_em_step(st, t0: float, h: float) -> StepOutcome:
         A = J + (c * M - 0.5 * Kf + H).toarray()
         return np.block([[A, Gd.T.toarray()], [G1.toarray(), np.zeros((m, m))]]), floor
 
-    x0 = np.concatenate([st._predict(h), st.lam / sm])
+    return residual, jacobian, np.concatenate([st._predict(h), st.lam / sm])
+
+
+def constrained_em_step(st, t0: float, h: float) -> StepOutcome:
+    """One step of ``st`` (an :class:`~ancfdae.integrators.EnergyMomentum` on a constrained model)."""
+    residual, jacobian, x0 = constrained_em_equations(st, t0, h)
     out = st._solve(residual, jacobian, x0)
     if not out.converged:
         return StepOutcome.failure(f"Newton: {out.message}")
-    y, lam = out.x[:n], sm * out.x[n:]
+    q0, v0, n, model = st.q, st.v, st.q.size, st.model
+    tm, t1 = t0 + 0.5 * h, t0 + h
+    hv0 = h * v0
+    y, lam = out.x[:n], 2.0 / (h * h) * st._mscale * out.x[n:]
     q1 = q0 + (hv0 + y)
     v1 = v0 + (2.0 / h) * y
     # The acceleration at t1 for the predictor and the interpolation only: M a1 = -r(t1, q1, v1, 0) - G^T lam,
