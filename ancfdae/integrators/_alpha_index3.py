@@ -76,7 +76,8 @@ def index3_equations(st, t: float, h: float):
         A = J.combine(1.0, c_v, s) + model.constraint_force_jacobian(t1, q1, lam)
         m = G.shape[0]
         mat = sp.bmat([[A, sm * G.T], [sm * G, sp.csr_matrix((m, m))]], format="csr")
-        return mat, st.floor_of(J.K, q1)
+        # the round-off of the dynamic rows and of the scaled constraint rows
+        return mat, max(st.floor_of(J.K, q1), st.floor_of(sm * G, q1))
 
     x0 = np.concatenate([(b * h * h) * ah0, st.lam / sm])
     return residual, jacobian, x0, state

@@ -64,9 +64,11 @@ def constrained_em_equations(st, t0: float, h: float):
         qm = q0 + 0.5 * u
         _, Kf = model.nonconservative_force(tm, qm, True)
         J = dg.jacobian(q0 + u)
-        floor = st.floor_of(J, q0 + u)
-        H = 0.25 * (model.constraint_force_jacobian(t0, qm, lam) + model.constraint_force_jacobian(t1, qm, lam))
         Gd, G1 = sm * sp.csr_matrix(G_d(qm)), sm * sp.csr_matrix(model.constraint_jacobian(t1, q0 + u))
+        # the round-off of the gradient rows and of the scaled constraint rows (a model without stiffness,
+        # such as point masses on rods, has only the latter)
+        floor = max(st.floor_of(J, q0 + u), st.floor_of(G1, q0 + u))
+        H = 0.25 * (model.constraint_force_jacobian(t0, qm, lam) + model.constraint_force_jacobian(t1, qm, lam))
         m = G1.shape[0]
         if sp.issparse(J):
             A = sp.csr_matrix(c * M + J - 0.5 * Kf + H)
