@@ -21,8 +21,11 @@ _FIT_TOL = 1e-9
 class Rigid(Joint):
     """A weld: the points coincide and the frame vectors keep their initial relation (at any angle).
 
-    To the ground every coordinate of the point and of the frame vectors keeps its initial value: the same
-    as a clamp by elimination (``supports={0: "clamp"}``), with the reaction forces as multipliers. Between
+    To the ground the point keeps its initial position and every frame vector its initial *direction*
+    (``d . n_k = 0`` for the normals ``n_k`` of that direction; its length, a beam's axial stretch, stays
+    free): for the thin elements the same as a clamp by elimination (``supports={0: "clamp"}``, which
+    leaves the axial slope free for the same reason), with the reaction forces as multipliers; with
+    ``fix_lengths=True`` the lengths are kept too (``u . d = |d0|``), the clamp of SQ2D/SQ3D. Between
     two bodies ``d_b,k = sum_j C_kj e_j`` with ``e_j`` the frame vectors of side ``a`` (planar: also those
     turned by 90 degrees) and ``C`` fitted in the initial configuration: linear rows, rotation-invariant
     (beams welded at an angle stay welded at that angle as they turn; a slope that stretches carries the
@@ -33,13 +36,18 @@ class Rigid(Joint):
     ----------
     a, b : side
         ``"ground"`` or ``(body, where)``.
+    fix_lengths : bool
+        To the ground only: keep the frame vectors' lengths as well as their directions.
     name : str, optional
     """
 
     kind = "Rigid"
 
-    def __init__(self, a, b, *, name: str | None = None) -> None:
+    def __init__(self, a, b, *, fix_lengths: bool = False, name: str | None = None) -> None:
         super().__init__((("a", a), ("b", b)), name)
+        if not isinstance(fix_lengths, bool):
+            raise ValueError(f"`fix_lengths` must be True or False, got {fix_lengths!r}.")
+        self.fix_lengths = fix_lengths
 
     def rows(self, frames: tuple[Frame, ...], q0: np.ndarray, n: int) -> Rows:
         dim = self.check_dim(frames)
@@ -50,8 +58,15 @@ class Rigid(Joint):
             body = fb if fa.ground else fa
             linear(rows, f"{label}.r", body.point - constant(body.point.value(q0), n))
             for k, d in enumerate(body.axes):
-                linear(rows, f"{label}.d{k}", d - constant(d.value(q0), n))
+                u = vector(f"frame vector {k} of {body.label}", d.value(q0), dim, unit=True)
+                for j, nj in enumerate(normals(u)):
+                    dot(rows, f"{label}.d{k}[{j}]", d, constant(nj, n))
+                if self.fix_lengths:
+                    dot(rows, f"{label}.|d{k}|", d, constant(u, n), -float(u @ d.value(q0)))
             return rows
+        if self.fix_lengths:
+            raise ValueError(f"{label}: `fix_lengths` is for a weld to the ground; between bodies the frame "
+                             "vectors are tied with their lengths.")
         linear(rows, f"{label}.r", fa.point - fb.point)
         basis = list(fa.axes) + ([d.rotated() for d in fa.axes] if dim == 2 else [])
         if not basis and fb.axes:

@@ -53,7 +53,7 @@ def spatial(kind):
         "spherical": [Spherical("ground", (c, 0)), Spherical((s1, 0.75), (s2, {"s": 0.3}))],
         "revolute": [Revolute((s1, 0), "ground"), Revolute((c, -1), (s2, 1), normals=(0, 1))],
         # side a's directors (e_y, e_z of s1) span c's slope (e_y): a weld at a right angle
-        "rigid": [Rigid((s1, 0.4), (c, 0.5)), Rigid("ground", (s2, 0))],
+        "rigid": [Rigid((s1, 0.4), (c, 0.5)), Rigid("ground", (s2, 0), fix_lengths=True)],
         "prismatic": [Prismatic((c, -1), "ground", direction=(1.0, 2.0, 0.5)),
                       Prismatic((s1, -1), (s2, 0.5), normals=(0, 1))],
         "distance": [Distance((s1, 0.2), (c, -2)), Distance((s2, 0.1), "ground", at=(0.3, -0.4, 0.2))],
