@@ -59,6 +59,8 @@ class StepOutcome:
         The step's own quadrature rule, when the method has one worth using (Lobatto IIIA).
     message : str
         Why the step failed (empty on success).
+    lam : ndarray, shape (n_constraints,), or None
+        The method's own multipliers at ``t`` for a model with the ``"constraints"`` capability.
     """
 
     ok: bool
@@ -68,6 +70,7 @@ class StepOutcome:
     a: np.ndarray | None = None
     quadrature: Quadrature | None = None
     message: str = ""
+    lam: np.ndarray | None = None
 
     @classmethod
     def failure(cls, message: str) -> StepOutcome:
