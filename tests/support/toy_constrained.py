@@ -211,8 +211,11 @@ class PointChains:
         return 0.5 * np.einsum("j,ijk,k->i", q, self.A, q) + B[0] @ q + c[0]
 
     def constraint_jacobian(self, t, q):
+        return self._gcsr(self.dense_constraint_jacobian(t, q))
+
+    def dense_constraint_jacobian(self, t, q):
         B, _ = self._parts(t)
-        return self._gcsr(self.A @ q + B[0])
+        return self.A @ q + B[0]
 
     def constraint_force_jacobian(self, t, q, lam):
         return sp.csr_matrix(np.einsum("i,ijk->jk", lam, self.A))
@@ -298,10 +301,11 @@ def hub(nseg=3, EA=SOFT["EA"], EI=SOFT["EI"], damping=SOFT["damping"]):
 def kkt(model, t, q, v):
     """(a, lam) from [[M, G^T], [G, 0]] [a; lam] = [-f; gamma] (dense)."""
     n, m = model.n_dof, model.n_constraints
-    G = model.constraint_jacobian(t, q).toarray()
+    G = model.dense_constraint_jacobian(t, q)
     _, gam = model.constraint_rates(t, q, v)
-    J = np.block([[model.M, G.T], [G, np.zeros((m, m))]])
-    x = np.linalg.solve(J, np.r_[-model.residual(t, q, v, np.zeros(n)), gam])
+    J = np.zeros((n + m, n + m))
+    J[:n, :n], J[:n, n:], J[n:, :n] = model.M, G.T, G
+    x = np.linalg.solve(J, np.r_[-model._forces(q, v, False)[0], gam])
     return x[:n], x[n:]
 
 
