@@ -153,11 +153,17 @@ class Model(Protocol):
 #:     ``symmetry_generators``, ``potential_degree``), see :class:`PotentialModel`
 #:     (energy-momentum integrators).
 #: ``"constraints"``
-#:     holonomic constraints ``g(t, q) = 0`` (joints, prescribed motions): ``n_constraints``,
-#:     ``constraints``, ``constraint_jacobian``, ``constraint_force_jacobian``, ``constraint_rates``, see
-#:     :class:`ConstrainedModel`. The equations of motion become ``r(t, q, v, a) + G^T lam = 0``,
-#:     ``g(t, q) = 0``; ``residual`` stays without the ``G^T lam`` term (the integrator adds it), and only
-#:     a stepper that declares ``handles_constraints = True`` is run on such a model.
+#:     holonomic constraints ``g(t, q) = 0`` (``n_constraints`` rows); the equations of motion become
+#:     ``r(t, q, v, a) + G^T lam = 0``, ``g = 0`` (``residual`` stays without ``G^T lam``):
+#:     ``n_constraints`` (int), ``constraints(t, q) -> g`` (m,), ``constraint_jacobian(t, q) -> G``
+#:     (csr (m, n), fixed pattern), ``constraint_force_jacobian(t, q, lam) -> d(G^T lam)/dq`` (csr
+#:     (n, n)), ``constraint_rates(t, q, v) -> (g_t, gamma)``: the velocity constraint is
+#:     ``G v + g_t = 0``, the acceleration constraint ``G a = gamma``. Optional within it:
+#:     ``constraint_velocity_jacobian(t, q, v) -> d(G v + g_t)/dq`` (csr (m, n)), which the index-2
+#:     (stabilised) formulations put in their Newton matrices; without it they form ``d(G v)/dq``
+#:     from ``m`` calls of ``constraint_force_jacobian`` and leave out ``dg_t/dq`` (exact for
+#:     constraints that do not depend on time). Only a stepper that declares
+#:     ``handles_constraints = True`` is run on such a model (see :class:`ConstrainedModel`).
 CAPABILITIES: dict[str, tuple[str, ...]] = {
     "residual_jacobian": ("residual_jacobian",),
     "residual_stages": ("residual_stages",),

@@ -70,7 +70,7 @@ class Integrator(ABC):
     order: int | None = None
     fixed_step: bool = True
     consistent_restart: bool = False
-    #: True when the method integrates models with the "constraints" capability (see the protocol)
+    #: True for a stepper that integrates models with the ``"constraints"`` capability
     handles_constraints: bool = False
 
     def __init__(self, model: Model, h: float | None = None) -> None:
@@ -98,8 +98,10 @@ class Integrator(ABC):
             End of the run.
         want_quadrature : bool
             True when monitors will use each step's quadrature.
-        lam0 : array_like, optional
-            The consistent multipliers of a constrained model (kept as ``self.lam``).
+        lam0 : array_like, shape (n_constraints,), optional
+            The consistent initial multipliers of a model with the ``"constraints"`` capability
+            (with ``a0`` from the same KKT system); None: a stepper that handles constraints
+            computes both itself.
         """
         self.model.rebind(model)
         self.want_quadrature = bool(want_quadrature)
