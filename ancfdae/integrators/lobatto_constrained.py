@@ -42,8 +42,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ancfdae.integrators._constraint_terms import velocity_constraint_jacobian
-from ancfdae.integrators._csr_numba import csr_matvec, csr_rmatvec
-from ancfdae.integrators._linsolve import factorize
+from ancfdae.integrators._csr_numba import csr_matvec, csr_rmatvec, ggl_expand, ggl_reduce, ggl_stage_rows
+from ancfdae.integrators._linsolve import _factorize_pattern
 from ancfdae.integrators.protocol import Quadrature, StepOutcome
 from ancfdae.problem import capabilities
 
@@ -106,6 +106,7 @@ class GGLStages:
         self.c = tab.c[1:].copy()
         model = stepper.model
         self.t_step = self.h_step = None
+        self._assembly = None
         self.n, self.m = stepper.n_dof, int(model.n_constraints)
         diag = np.abs(sp.csr_matrix(model.mass(stepper.q)).diagonal())
         self.ms = float(diag.max()) if diag.size and diag.max() > 0 else 1.0
@@ -125,6 +126,22 @@ class GGLStages:
                 last[i] = cols.max() + 0.5
         keys = np.r_[np.repeat(np.arange(n, dtype=float), ns), np.repeat(last, ns), np.repeat(last, ns)]
         return np.argsort(keys, kind="stable")
+
+    def assemble(self, rows, cols, vals, N):
+        """CSR from COO triples; the slot map is kept while the triples' pattern repeats (modified Newton
+        refreshes the same structure), so the pattern arrays -- and the banded LU's map -- are reused."""
+        c = self._assembly
+        if c is not None and c[0].size == rows.size and np.array_equal(c[0], rows) and np.array_equal(c[1], cols):
+            _, _, slot, indptr, indices = c
+        else:
+            P = sp.csr_matrix((np.arange(1, rows.size + 1, dtype=float), (rows, cols)), shape=(N, N))
+            P.sum_duplicates()
+            P.sort_indices()
+            key = np.repeat(np.arange(N), np.diff(P.indptr)).astype(np.int64) * N + P.indices
+            slot = np.searchsorted(key, rows.astype(np.int64) * N + cols)
+            indptr, indices = P.indptr, P.indices
+            self._assembly = (rows, cols, slot, indptr, indices)
+        return np.bincount(slot, weights=vals, minlength=indices.size), indptr, indices
 
     # -- unknowns ------------------------------------------------------------------------------
     def split(self, x):
@@ -160,23 +177,23 @@ class GGLStages:
     # -- residual ------------------------------------------------------------------------------
     def residual(self, x, t, h):
         """The scaled stage residual (module docstring), flat in the layout of ``x``."""
-        model, ms = self.stepper.model, self.ms
+        model, ms, n, ns = self.stepper.model, self.ms, self.n, self.ns
         ts, Q, V, A, L, U = self.states(x, t, h)
         K = self.split(x)[0]
-        RK, RD = np.empty_like(K), np.empty_like(K)
-        Rg, Rv = np.empty_like(L), np.empty_like(L)
-        n = self.n
+        out = np.empty(x.size)
+        RD = out[n * ns:2 * n * ns].reshape(n, ns)
         if self.stages is not None:      # every stage's model residual in one call
             RD[:] = self.stages(ts, Q, V, A)
-        for i in range(self.ns):
+        for i in range(ns):
             q, v = Q[:, i], V[:, i]
+            if self.stages is None:
+                RD[:, i] = model.residual(ts[i], q, v, A[:, i])
             G = as_csr(model.constraint_jacobian(ts[i], q))
-            RK[:, i] = (ms / h) * (K[:, i] - v - h * rmatvec(G, U[:, i], n))
-            r = RD[:, i] if self.stages is not None else model.residual(ts[i], q, v, A[:, i])
-            RD[:, i] = r + rmatvec(G, L[:, i], n)
-            Rg[:, i] = (ms / (h * h)) * model.constraints(ts[i], q)
-            Rv[:, i] = (ms / h) * (matvec(G, v) + model.constraint_rates(ts[i], q, v)[0])
-        return np.concatenate([RK.ravel(), RD.ravel(), Rg.ravel(), Rv.ravel()])
+            g = np.asarray(model.constraints(ts[i], q), dtype=float)
+            g_t = np.asarray(model.constraint_rates(ts[i], q, v)[0], dtype=float)
+            ggl_stage_rows(out, i, n, self.m, ns, ms, h, G.indptr, G.indices, G.data.astype(float, copy=False),
+                           K, V, U, L, g, g_t)
+        return out
 
     # -- Newton matrix -------------------------------------------------------------------------
     def blocks(self, x, t, h, stages):
@@ -205,8 +222,15 @@ class ReducedMatrix:
         self.frozen = all(b is blocks[0] for b in blocks)   # modified Newton: the last stage's blocks
 
     def matrix(self, permuted: bool = False) -> sp.csr_matrix:
-        """The reduced matrix in ``[A, Lam, U]`` (stage copies interleaved; ``permuted``: on the banded
-        ordering ``perm`` of the system, i.e. entry ``(perm[i], perm[j])`` moved to ``(i, j)``)."""
+        """The reduced matrix as CSR (see :meth:`triples`)."""
+        data, indptr, indices = self.triples(permuted)
+        N = indptr.size - 1
+        return sp.csr_matrix((data, indices, indptr), shape=(N, N))
+
+    def triples(self, permuted: bool = False):
+        """The reduced matrix in ``[A, Lam, U]`` as CSR arrays ``(data, indptr, indices)`` (stage copies
+        interleaved; ``permuted``: on the banded ordering ``perm`` of the system, i.e. entry
+        ``(perm[i], perm[j])`` moved to ``(i, j)``)."""
         s, h, ms, blk = self.system, self.h, self.system.ms, self.blocks
         a, a2, ns, n, m = s.a, s.a2, s.ns, s.n, s.m
         oA, oL, oU = 0, n * ns, n * ns + m * ns
@@ -234,11 +258,12 @@ class ReducedMatrix:
         N = (n + 2 * m) * ns
         if permuted:
             rows, cols = s.inv_perm[rows], s.inv_perm[cols]
-        return sp.csr_matrix((vals, (rows, cols)), shape=(N, N))
+        return s.assemble(rows, cols, vals, N)   # (data, indptr, indices): CSR arrays
 
     def factorize(self):
         """Factorise on the banded ordering; returns an object with ``solve(r)`` for the full residual."""
-        return _ReducedFactor(self, factorize(self.matrix(permuted=True)))
+        data, indptr, indices = self.triples(permuted=True)   # the same pattern arrays: band map cached
+        return _ReducedFactor(self, _factorize_pattern(data, indptr, indices, indptr.size - 1))
 
 
 class _ReducedFactor:
@@ -246,8 +271,17 @@ class _ReducedFactor:
 
     def __init__(self, rm: ReducedMatrix, lu) -> None:
         self.rm, self.lu = rm, lu
+        if rm.frozen:     # the compiled path: arrays of the one set of blocks
+            Kt, _, _, G, W = rm.blocks[0]
+            s = rm.system
+            self._args = (s.n, s.m, s.ns, rm.h, s.ms, s.a) + tuple(
+                x for B in (Kt, G, W) for x in (B.indptr, B.indices, B.data.astype(float, copy=False)))
+            self._exp = (s.n, s.m, s.ns, rm.h, s.a, G.indptr, G.indices, G.data.astype(float, copy=False), s.perm)
 
     def solve(self, r):
+        if self.rm.frozen:
+            bp, rho = ggl_reduce(np.asarray(r, dtype=float), *self._args, self.rm.system.perm)
+            return ggl_expand(np.asarray(self.lu.solve(bp), dtype=float), rho, *self._exp)
         s, h, ms, blk = self.rm.system, self.rm.h, self.rm.system.ms, self.rm.blocks
         n, m, ns = s.n, s.m, s.ns
         RK, RD, Rg, Rv = s.split(np.asarray(r, dtype=float))
