@@ -42,16 +42,50 @@ import numpy as np
 import scipy.sparse as sp
 
 from ancfdae.integrators._constraint_terms import velocity_constraint_jacobian
-from ancfdae.integrators._linsolve import factorize
+from ancfdae.integrators._csr_numba import csr_matvec, csr_rmatvec, ggl_expand, ggl_reduce, ggl_stage_rows
+from ancfdae.integrators._linsolve import _factorize_pattern
 from ancfdae.integrators.protocol import Quadrature, StepOutcome
+from ancfdae.problem import capabilities
 
 __all__ = ["GGLStages", "ReducedMatrix", "ggl_step"]
 
 
+def as_csr(G) -> sp.csr_matrix:
+    """``G`` itself when it is a CSR matrix (no copy, no format check), else converted."""
+    return G if getattr(G, "format", None) == "csr" else sp.csr_matrix(G)
+
+
 def rmatvec(G: sp.csr_matrix, u: np.ndarray, n: int) -> np.ndarray:
-    """``G^T u`` for a CSR ``G`` of ``n`` columns, without forming the transpose (one bincount)."""
-    w = G.data * np.repeat(u, np.diff(G.indptr))
-    return np.bincount(G.indices, weights=w, minlength=n)
+    """``G^T u`` for a CSR ``G`` of ``n`` columns, without forming the transpose (compiled)."""
+    return csr_rmatvec(G.indptr, G.indices, G.data.astype(float, copy=False), np.ascontiguousarray(u, dtype=float), n)
+
+
+def matvec(G: sp.csr_matrix, x: np.ndarray) -> np.ndarray:
+    """``G x`` for a CSR ``G`` with few rows (compiled; scipy's product costs more to call)."""
+    return csr_matvec(G.indptr, G.indices, G.data.astype(float, copy=False), np.ascontiguousarray(x, dtype=float))
+
+
+def _coo(B):
+    """``(rows, cols, values)`` of a CSR matrix or a dense array (its nonzeros), without scipy's checks."""
+    if isinstance(B, np.ndarray):
+        r, c = np.nonzero(B)
+        return r, c, B[r, c]
+    return np.repeat(np.arange(B.shape[0]), np.diff(B.indptr)), B.indices, B.data
+
+
+def _transposed(trip):
+    return trip[1], trip[0], trip[2]
+
+
+def _stage_terms(B, C, ns, r0, c0):
+    """COO of ``kron(B, C)`` placed at offsets ``(r0, c0)``: entry ``(p ns + i, q ns + k) = B_pq C_ik``
+    (``B`` a CSR matrix, a dense array or a ``(rows, cols, values)`` triple; ``C`` an (ns, ns)
+    coefficient array, zeros skipped)."""
+    p, q, b = B if isinstance(B, tuple) else _coo(B)
+    i, k = np.nonzero(C)
+    rows = (r0 + p[:, None] * ns + i[None, :]).ravel()
+    cols = (c0 + q[:, None] * ns + k[None, :]).ravel()
+    return rows, cols, (b[:, None] * C[i, k][None, :]).ravel()
 
 
 class GGLStages:
@@ -71,10 +105,15 @@ class GGLStages:
         self.a2 = (tab.a @ tab.a)[1:, 1:].copy()
         self.c = tab.c[1:].copy()
         model = stepper.model
+        self.t_step = self.h_step = None
+        self._assembly = None
         self.n, self.m = stepper.n_dof, int(model.n_constraints)
         diag = np.abs(sp.csr_matrix(model.mass(stepper.q)).diagonal())
         self.ms = float(diag.max()) if diag.size and diag.max() > 0 else 1.0
         self.perm = self._ordering(sp.csr_matrix(model.constraint_jacobian(stepper.t, stepper.q)))
+        self.inv_perm = np.empty_like(self.perm)
+        self.inv_perm[self.perm] = np.arange(self.perm.size)
+        self.stages = model.residual_stages if "residual_stages" in capabilities(model) else None
 
     def _ordering(self, G):
         """Permutation of ``[A (n ns), Lam (m ns), U (m ns)]`` (stage copies interleaved): each
@@ -88,6 +127,22 @@ class GGLStages:
         keys = np.r_[np.repeat(np.arange(n, dtype=float), ns), np.repeat(last, ns), np.repeat(last, ns)]
         return np.argsort(keys, kind="stable")
 
+    def assemble(self, rows, cols, vals, N):
+        """CSR from COO triples; the slot map is kept while the triples' pattern repeats (modified Newton
+        refreshes the same structure), so the pattern arrays -- and the banded LU's map -- are reused."""
+        c = self._assembly
+        if c is not None and c[0].size == rows.size and np.array_equal(c[0], rows) and np.array_equal(c[1], cols):
+            _, _, slot, indptr, indices = c
+        else:
+            P = sp.csr_matrix((np.arange(1, rows.size + 1, dtype=float), (rows, cols)), shape=(N, N))
+            P.sum_duplicates()
+            P.sort_indices()
+            key = np.repeat(np.arange(N), np.diff(P.indptr)).astype(np.int64) * N + P.indices
+            slot = np.searchsorted(key, rows.astype(np.int64) * N + cols)
+            indptr, indices = P.indptr, P.indices
+            self._assembly = (rows, cols, slot, indptr, indices)
+        return np.bincount(slot, weights=vals, minlength=indices.size), indptr, indices
+
     # -- unknowns ------------------------------------------------------------------------------
     def split(self, x):
         """``K, A`` (n, ns), ``Lam, U`` (m, ns) of the flat unknown vector."""
@@ -96,13 +151,20 @@ class GGLStages:
         return (x[:n * ns].reshape(n, ns), x[n * ns:o].reshape(n, ns),
                 x[o:o + m * ns].reshape(m, ns), x[o + m * ns:].reshape(m, ns))
 
+    def begin(self, t, h):
+        """Fix the step ``(t, h)``: stage times and the parts of ``Q, V`` that do not depend on ``x``."""
+        st = self.stepper
+        self.t_step, self.h_step, self.ts = t, h, t + self.c * h
+        self.Q0 = st.q[:, None] + h * np.outer(st.v, self.a_first)
+        self.V0 = st.v[:, None] + h * np.outer(st.a, self.a_first)
+        self.haT = h * self.a.T
+
     def states(self, x, t, h):
         """Stage times, ``Q, V, A, Lam, U`` at the unknowns ``x`` of the step ``(t, h)``."""
-        st = self.stepper
+        if t != self.t_step or h != self.h_step:
+            self.begin(t, h)
         K, A, L, U = self.split(x)
-        Q = st.q[:, None] + h * np.outer(st.v, self.a_first) + h * K @ self.a.T
-        V = st.v[:, None] + h * np.outer(st.a, self.a_first) + h * A @ self.a.T
-        return t + self.c * h, Q, V, A, L, U
+        return self.ts, self.Q0 + K @ self.haT, self.V0 + A @ self.haT, A, L, U
 
     def guess(self, h):
         """``K_i = v_n + c_i h a_n``, ``A_i = a_n``, ``Lam_i = lam_n``, ``U_i = 0``."""
@@ -115,19 +177,23 @@ class GGLStages:
     # -- residual ------------------------------------------------------------------------------
     def residual(self, x, t, h):
         """The scaled stage residual (module docstring), flat in the layout of ``x``."""
-        model, ms = self.stepper.model, self.ms
+        model, ms, n, ns = self.stepper.model, self.ms, self.n, self.ns
         ts, Q, V, A, L, U = self.states(x, t, h)
         K = self.split(x)[0]
-        RK, RD = np.empty_like(K), np.empty_like(K)
-        Rg, Rv = np.empty_like(L), np.empty_like(L)
-        n = self.n
-        for i in range(self.ns):
-            G = sp.csr_matrix(model.constraint_jacobian(ts[i], Q[:, i]))
-            RK[:, i] = (ms / h) * (K[:, i] - V[:, i] - h * rmatvec(G, U[:, i], n))
-            RD[:, i] = model.residual(ts[i], Q[:, i], V[:, i], A[:, i]) + rmatvec(G, L[:, i], n)
-            Rg[:, i] = (ms / (h * h)) * model.constraints(ts[i], Q[:, i])
-            Rv[:, i] = (ms / h) * (G @ V[:, i] + model.constraint_rates(ts[i], Q[:, i], V[:, i])[0])
-        return np.concatenate([RK.ravel(), RD.ravel(), Rg.ravel(), Rv.ravel()])
+        out = np.empty(x.size)
+        RD = out[n * ns:2 * n * ns].reshape(n, ns)
+        if self.stages is not None:      # every stage's model residual in one call
+            RD[:] = self.stages(ts, Q, V, A)
+        for i in range(ns):
+            q, v = Q[:, i], V[:, i]
+            if self.stages is None:
+                RD[:, i] = model.residual(ts[i], q, v, A[:, i])
+            G = as_csr(model.constraint_jacobian(ts[i], q))
+            g = np.asarray(model.constraints(ts[i], q), dtype=float)
+            g_t = np.asarray(model.constraint_rates(ts[i], q, v)[0], dtype=float)
+            ggl_stage_rows(out, i, n, self.m, ns, ms, h, G.indptr, G.indices, G.data.astype(float, copy=False),
+                           K, V, U, L, g, g_t)
+        return out
 
     # -- Newton matrix -------------------------------------------------------------------------
     def blocks(self, x, t, h, stages):
@@ -140,7 +206,7 @@ class GGLStages:
             blk = model.jacobian(ts[i], Q[:, i], V[:, i], A[:, i])
             Kt = sp.csr_matrix(blk.K + model.constraint_force_jacobian(ts[i], Q[:, i], L[:, i]))
             G = sp.csr_matrix(model.constraint_jacobian(ts[i], Q[:, i]))
-            W = velocity_constraint_jacobian(model, ts[i], Q[:, i], V[:, i])
+            W = as_csr(velocity_constraint_jacobian(model, ts[i], Q[:, i], V[:, i]))
             out.append((Kt, sp.csr_matrix(blk.D), sp.csr_matrix(blk.M), G, W))
             floor = max(floor, st.floor_of(blk.K, Q[:, i]))
         if len(out) == 1:
@@ -148,44 +214,56 @@ class GGLStages:
         return ReducedMatrix(self, out, h), floor
 
 
-def _kron_sum(terms, ns, shape):
-    """``sum kron(B_ik, E_ik)`` over ``((i, k), B)``: the stage-interleaved block matrix."""
-    out = sp.csr_matrix((shape[0] * ns, shape[1] * ns))
-    for (i, k), B in terms:
-        if B is None:
-            continue
-        E = sp.csr_matrix(([1.0], ([i], [k])), shape=(ns, ns))
-        out = out + sp.kron(B, E, format="csr")
-    return out
-
-
 class ReducedMatrix:
     """The Newton matrix of the GGL stage system with the kinematic rows eliminated (``factorize``)."""
 
     def __init__(self, system: GGLStages, blocks, h: float) -> None:
         self.system, self.blocks, self.h = system, blocks, float(h)
+        self.frozen = all(b is blocks[0] for b in blocks)   # modified Newton: the last stage's blocks
 
-    def matrix(self) -> sp.csr_matrix:
-        """The reduced matrix in ``[A, Lam, U]`` (natural order, stage copies interleaved)."""
+    def matrix(self, permuted: bool = False) -> sp.csr_matrix:
+        """The reduced matrix as CSR (see :meth:`triples`)."""
+        data, indptr, indices = self.triples(permuted)
+        N = indptr.size - 1
+        return sp.csr_matrix((data, indices, indptr), shape=(N, N))
+
+    def triples(self, permuted: bool = False):
+        """The reduced matrix in ``[A, Lam, U]`` as CSR arrays ``(data, indptr, indices)`` (stage copies
+        interleaved; ``permuted``: on the banded ordering ``perm`` of the system, i.e. entry
+        ``(perm[i], perm[j])`` moved to ``(i, j)``)."""
         s, h, ms, blk = self.system, self.h, self.system.ms, self.blocks
         a, a2, ns, n, m = s.a, s.a2, s.ns, s.n, s.m
-        pairs = [(i, k) for i in range(ns) for k in range(ns)]
-        AA = _kron_sum([((i, k), a2[i, k] * h * h * blk[i][0] + a[i, k] * h * blk[i][1]
-                         + (blk[i][2] if i == k else 0 * blk[i][2])) for i, k in pairs], ns, (n, n))
-        AL = _kron_sum([((i, i), blk[i][3].T) for i in range(ns)], ns, (n, m))
-        AU = _kron_sum([((i, k), (a[i, k] * h * h) * (blk[i][0] @ blk[k][3].T)) for i, k in pairs], ns, (n, m))
-        LA = _kron_sum([((i, k), (ms * a2[i, k]) * blk[i][3]) for i, k in pairs], ns, (m, n))
-        LU = _kron_sum([((i, k), (ms * a[i, k]) * (blk[i][3] @ blk[k][3].T)) for i, k in pairs], ns, (m, m))
-        UA = _kron_sum([((i, k), ms * (a[i, k] * blk[i][3] + (h * a2[i, k]) * blk[i][4])) for i, k in pairs],
-                       ns, (m, n))
-        UU = _kron_sum([((i, k), (ms * h * a[i, k]) * (blk[i][4] @ blk[k][3].T)) for i, k in pairs], ns, (m, m))
-        return sp.bmat([[AA, AL, AU], [LA, None, LU], [UA, None, UU]], format="csr")
+        oA, oL, oU = 0, n * ns, n * ns + m * ns
+        parts = []
+        eye = np.eye(ns)
+        dense = [(b[3].toarray(), b[4].toarray()) for b in (blk[:1] if self.frozen else blk)]   # (G, W), m rows
+        for i in range(ns) if not self.frozen else [None]:
+            # rows of stage i (all stages at once when the blocks are frozen)
+            sel = np.ones((ns, ns)) if i is None else np.outer(eye[i], np.ones(ns))
+            Kt, D, M, G, W = blk[0 if i is None else i]
+            Gd, Wd = dense[0 if i is None else i]
+            g = _coo(G)
+            parts += [_stage_terms(M, sel * eye, ns, oA, oA), _stage_terms(D, h * sel * a, ns, oA, oA),
+                      _stage_terms(Kt, h * h * sel * a2, ns, oA, oA), _stage_terms(_transposed(g), sel * eye, ns, oA, oL),
+                      _stage_terms(g, ms * sel * a2, ns, oL, oA), _stage_terms(g, ms * sel * a, ns, oU, oA),
+                      _stage_terms(W, ms * h * sel * a2, ns, oU, oA)]
+            for k in range(ns) if not self.frozen else [None]:
+                # columns of stage k's mu: G_k^T enters through dQ (products with few columns: dense)
+                ck = sel if k is None else sel * np.outer(np.ones(ns), eye[k])
+                GcT = (Gd if k is None else dense[k][0]).T
+                parts += [_stage_terms(np.asarray(Kt @ GcT), h * h * ck * a, ns, oA, oU),
+                          _stage_terms(Gd @ GcT, ms * ck * a, ns, oL, oU),
+                          _stage_terms(Wd @ GcT, ms * h * ck * a, ns, oU, oU)]
+        rows, cols, vals = (np.concatenate(x) for x in zip(*parts))
+        N = (n + 2 * m) * ns
+        if permuted:
+            rows, cols = s.inv_perm[rows], s.inv_perm[cols]
+        return s.assemble(rows, cols, vals, N)   # (data, indptr, indices): CSR arrays
 
     def factorize(self):
         """Factorise on the banded ordering; returns an object with ``solve(r)`` for the full residual."""
-        p = self.system.perm
-        J = self.matrix()[p][:, p]
-        return _ReducedFactor(self, factorize(sp.csr_matrix(J)))
+        data, indptr, indices = self.triples(permuted=True)   # the same pattern arrays: band map cached
+        return _ReducedFactor(self, _factorize_pattern(data, indptr, indices, indptr.size - 1))
 
 
 class _ReducedFactor:
@@ -193,19 +271,30 @@ class _ReducedFactor:
 
     def __init__(self, rm: ReducedMatrix, lu) -> None:
         self.rm, self.lu = rm, lu
+        if rm.frozen:     # the compiled path: arrays of the one set of blocks
+            Kt, _, _, G, W = rm.blocks[0]
+            s = rm.system
+            self._args = (s.n, s.m, s.ns, rm.h, s.ms, s.a) + tuple(
+                x for B in (Kt, G, W) for x in (B.indptr, B.indices, B.data.astype(float, copy=False)))
+            self._exp = (s.n, s.m, s.ns, rm.h, s.a, G.indptr, G.indices, G.data.astype(float, copy=False), s.perm)
 
     def solve(self, r):
+        if self.rm.frozen:
+            bp, rho = ggl_reduce(np.asarray(r, dtype=float), *self._args, self.rm.system.perm)
+            return ggl_expand(np.asarray(self.lu.solve(bp), dtype=float), rho, *self._exp)
         s, h, ms, blk = self.rm.system, self.rm.h, self.rm.system.ms, self.rm.blocks
         n, m, ns = s.n, s.m, s.ns
         RK, RD, Rg, Rv = s.split(np.asarray(r, dtype=float))
         rho = RK * (h / ms)
         P = h * rho @ s.a.T
-        bD, bg, bv = RD.copy(), Rg.copy(), Rv.copy()
+        bD = RD - blk[0][0] @ P if self.rm.frozen else RD.copy()   # frozen: one product for all stages
+        bg, bv = Rg.copy(), Rv.copy()
         for i in range(ns):
             Kt, _, _, G, W = blk[i]
-            bD[:, i] -= Kt @ P[:, i]
-            bg[:, i] -= (ms / (h * h)) * (G @ P[:, i])
-            bv[:, i] -= (ms / h) * (W @ P[:, i])
+            if not self.rm.frozen:
+                bD[:, i] -= Kt @ P[:, i]
+            bg[:, i] -= (ms / (h * h)) * matvec(G, P[:, i])
+            bv[:, i] -= (ms / h) * matvec(W, P[:, i])
         b = np.concatenate([bD.ravel(), bg.ravel(), bv.ravel()])
         z = np.empty_like(b)
         z[s.perm] = self.lu.solve(b[s.perm])
@@ -229,6 +318,7 @@ def ggl_step(stepper, system: GGLStages, t: float, h: float) -> StepOutcome:
     def jacobian(x):
         return system.blocks(x, t, h, range(system.ns) if per_stage[0] else last)
 
+    system.begin(t, h)
     guess = system.guess(h)
     out = stepper._solve(residual, jacobian, guess)
     if not out.converged and not per_stage[0]:
