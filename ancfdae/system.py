@@ -114,9 +114,10 @@ class System(BodyStack):
     def _stack_rows(self, blocks, joint_part):
         if not blocks:
             return joint_part
-        n = self.n_dof
-        shifted = [sp.csr_matrix((sp.csr_matrix(B).data, sp.csr_matrix(B).indices + o, sp.csr_matrix(B).indptr),
-                                 shape=(B.shape[0], n)) for B, o in blocks]
+        n, shifted = self.n_dof, []
+        for B, o in blocks:
+            B = sp.csr_matrix(B)
+            shifted.append(sp.csr_matrix((B.data, B.indices + o, B.indptr), shape=(B.shape[0], n)))
         return sp.vstack(shifted + [joint_part], format="csr")
 
     def constraint_jacobian(self, t: float, q: np.ndarray) -> sp.csr_matrix:
