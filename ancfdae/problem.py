@@ -282,6 +282,14 @@ class ConstrainedModel(Protocol):
     ----------
     n_constraints : int
         ``m``, the number of rows of ``g``.
+
+    Notes
+    -----
+    Optional, used when present: ``constraint_force(t, q, lam) -> G^T lam`` (without forming ``G``; the
+    steppers' residuals need it at every Newton iteration), ``constraint_velocity_jacobian(t, q, v) ->
+    d(G v + g_t)/dq`` (index-2 formulations), ``constraint_degree`` (1 or 2 when every row is at most
+    quadratic in ``q`` with time only in its linear part; the energy-momentum method requires it) and
+    ``constraint_labels`` (one name per row, for messages and results).
     """
 
     n_constraints: int

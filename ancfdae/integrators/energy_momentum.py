@@ -87,6 +87,7 @@ from ancfdae._scale import ENERGY_ROUNDOFF
 from ancfdae.integrators._alpha_index3 import mass_scale
 from ancfdae.integrators._discrete_gradient import AVFGradient, GonzalezGradient
 from ancfdae.integrators._em_constrained import constrained_em_step
+from ancfdae.kkt import KKTAssembler
 from ancfdae.integrators._newton_records import NewtonOptions
 from ancfdae.integrators.newton_stepper import NewtonStepper
 from ancfdae.integrators.protocol import Quadrature, StepOutcome
@@ -189,6 +190,7 @@ class EnergyMomentum(NewtonStepper):
         self._constrained = "constraints" in capabilities(self.model)
         if self._constrained:
             self._mscale = mass_scale(self._M)
+            self._kkt = KKTAssembler()
             if self.lam is None:
                 self.lam = np.zeros(self.model.n_constraints)
 

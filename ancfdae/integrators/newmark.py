@@ -41,6 +41,7 @@ import logging
 
 from ancfdae.integrators._affine import affine2, affine3, newmark_predict
 from ancfdae.integrators._alpha_index3 import index3_step, mass_scale
+from ancfdae.kkt import KKTAssembler
 from ancfdae.integrators._newton_records import NewtonOptions
 from ancfdae.integrators.newton_stepper import NewtonStepper
 from ancfdae.integrators.protocol import StepOutcome
@@ -85,6 +86,7 @@ class _AlphaFamily(NewtonStepper):
         self._constrained = "constraints" in capabilities(self.model)
         if self._constrained:
             self._ah = self.a.copy()
+            self._kkt = KKTAssembler()
             self._mscale = mass_scale(self.model.mass(self.q))
             if self.lam is None:
                 self.lam = np.zeros(self.model.n_constraints)
