@@ -36,10 +36,8 @@ folder or None). The command line (:mod:`ancfdae.studies._cli`) maps
 """
 from __future__ import annotations
 
-import json
 import multiprocessing
 import os
-import re
 import signal
 import sys
 import time
@@ -48,7 +46,7 @@ from concurrent.futures import FIRST_COMPLETED, Executor, ProcessPoolExecutor, w
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ancfdae.result import Result
+from ._store import CaseStore
 
 __all__ = ["Case", "OptionError", "output_dir", "CaseStore", "Sweep", "Interrupted", "run_cases", "progress_bar",
            "settings"]
@@ -92,78 +90,6 @@ class Case(dict):
 
     def __str__(self):
         return str(self.get("label", dict.__repr__(self)))
-
-
-def _jsonable(obj):
-    """Plain Python (lists, floats, ...) of ``obj`` for JSON; numpy scalars and arrays converted."""
-    if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    if hasattr(obj, "tolist"):
-        return obj.tolist()
-    return obj
-
-
-def _key(label: str) -> str:
-    """A file name from a case label ("BE2D 8 el (reference)" -> "BE2D_8_el_reference")."""
-    return re.sub(r"[^A-Za-z0-9.+-]+", "_", label).strip("_")
-
-
-class CaseStore:
-    """The finished cases of a study in ``folder/cases``.
-
-    Per case two files: the simulation's :class:`ancfdae.Result`, written by
-    :meth:`Result.save` (self-describing; its format is the library's), and
-    ``KEY.json`` with the case's options, its scalars (CPU time, counters, ...)
-    and the name of the Result file. The JSON is written last and atomically,
-    so a case counts as finished only once both files are complete. A case
-    whose function raised is kept as ``KEY.json`` with ``"error"``; it is run
-    again on the next run.
-    """
-
-    def __init__(self, folder):
-        self.folder = Path(folder) / "cases"
-        self.folder.mkdir(parents=True, exist_ok=True)
-
-    def _json(self, case) -> Path:
-        return self.folder / (_key(str(case)) + ".json")
-
-    def load(self, case):
-        """The stored record of ``case`` (a dict with ``"result"``), or None if absent, failed or stale."""
-        path = self._json(case)
-        if not path.is_file():
-            return None
-        try:
-            meta = json.loads(path.read_text())
-        except (OSError, ValueError):
-            return None
-        if meta.get("case") != _jsonable(dict(case)) or "error" in meta:
-            return None        # other options (or a failure): run it again
-        try:
-            result = Result.load(self.folder / meta["file"])
-        except (OSError, ValueError, KeyError):
-            return None
-        return dict(meta["record"], result=result)
-
-    def save(self, case, record: dict) -> Path:
-        """Write ``record`` (``"result"``: a Result; other entries JSON-able scalars) of ``case``."""
-        stem = _key(str(case))
-        file = record["result"].save(self.folder / stem)
-        scalars = {k: v for k, v in record.items() if k != "result"}
-        return self._write(case, {"case": _jsonable(dict(case)), "file": Path(file).name,
-                                  "record": _jsonable(scalars)})
-
-    def save_error(self, case, error: str) -> Path:
-        """Record that ``case`` raised (``error``: the exception's text)."""
-        return self._write(case, {"case": _jsonable(dict(case)), "error": error})
-
-    def _write(self, case, meta) -> Path:
-        path = self._json(case)
-        tmp = path.with_name(path.name + ".tmp")
-        tmp.write_text(json.dumps(meta, indent=1, allow_nan=True))
-        os.replace(tmp, path)
-        return path
 
 
 class Interrupted(KeyboardInterrupt):
@@ -273,7 +199,7 @@ def run_cases(fn, cases, out=None, executor: Executor | None = None, jobs: int |
     labels = [str(c) for c in cases]
     if len(set(labels)) != len(labels):
         raise ValueError(f"`cases` must have unique labels, got duplicates in {labels}.")
-    store = CaseStore(out) if out is not None else None
+    store = CaseStore(out, fn) if out is not None else None
     reduce = reduce or (lambda r: r)
     records = [None] * len(cases)
     todo = []
@@ -284,6 +210,8 @@ def run_cases(fn, cases, out=None, executor: Executor | None = None, jobs: int |
         else:
             records[i] = reduce(rec)
     sweep = Sweep(records, reused=len(cases) - len(todo))
+    for note in store.notes if store is not None else ():
+        print(f"{name}: {note}", file=sys.stderr, flush=True)
     if sweep.reused and progress:
         print(f"{name}: reusing {sweep.reused} of {len(cases)} finished cases from {store.folder}",
               file=sys.stderr, flush=True)
