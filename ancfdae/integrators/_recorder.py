@@ -49,15 +49,19 @@ class Recorder:
                 hook(model)
 
     def sample(self, t, q, v, a, state=None):
-        """Record one output time; ``state`` is the model's event state valid at ``t``."""
+        """Record one output time; ``state`` is the model's event state valid at ``t``.
+
+        The monitors sample first: when one raises (e.g. a probe whose value changed shape), the
+        output time is not recorded and the logs keep one row per recorded time.
+        """
+        for m in self.monitors:
+            m.sample(t, q, v, a)
         self.t.append(float(t))
         self.q.append(np.array(q, dtype=float))
         self.v.append(np.array(v, dtype=float))
         self.a.append(np.array(a, dtype=float))
         if state is not None:
             self.state.append(state)
-        for m in self.monitors:
-            m.sample(t, q, v, a)
 
     def stop_reason(self):
         """The first monitor's request to end the run, or None."""
