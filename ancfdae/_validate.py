@@ -29,6 +29,13 @@ def positive_int(name: str, value) -> int:
     return int(value)
 
 
+def flag(name: str, value) -> bool:
+    """Return ``value`` if it is True or False (numpy's bool too); raise ValueError otherwise."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"`{name}` must be True or False, got {value!r}.")
+    return bool(value)
+
+
 def finite_vector(name: str, value, size: int | None = None) -> np.ndarray:
     """Return ``value`` as a 1-D float array of finite entries (of length ``size`` if given)."""
     try:

@@ -24,6 +24,13 @@ _END_ULPS = 8.0
 class RunInterrupted(KeyboardInterrupt):
     """A KeyboardInterrupt (Ctrl-C) during a run, re-raised with the run's part computed so far.
 
+    Parameters
+    ----------
+    message : str
+        When the run was interrupted.
+    result : ancfdae.Result
+        The run so far.
+
     Attributes
     ----------
     result : ancfdae.Result
