@@ -36,7 +36,9 @@ folder or None). The command line (:mod:`ancfdae.studies._cli`) maps
 """
 from __future__ import annotations
 
+import math
 import multiprocessing
+import numbers
 import os
 import signal
 import sys
@@ -294,13 +296,38 @@ def _stop(pool) -> None:
         p.join(timeout=max(0.0, deadline - time.monotonic()))
 
 
-def settings(full: dict, quick_defaults: dict, quick: bool, given: dict) -> dict:
+def _numbers(value):
+    """The numbers in an option value (a number, or a list/tuple of them); text and None give none."""
+    if isinstance(value, (list, tuple)):
+        return [x for v in value for x in _numbers(v)]
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        return []
+    return [value]
+
+
+def settings(full: dict, quick_defaults: dict, quick: bool, given: dict, zero_allowed=(), unchecked=()) -> dict:
     """A study's options: the full (or, with ``quick``, the quick) defaults overridden by ``given``.
 
-    ``given`` holds the ``run`` arguments; None means "the mode's default".
+    ``given`` holds the ``run`` arguments; None means "the mode's default". Every number of the
+    result (also inside lists) must be finite and positive -- sizes, times, steps, tolerances --,
+    or zero for the options in ``zero_allowed`` ("0: none"); options in ``unchecked`` are not
+    checked. Checked here, before any work, so that a bad option is one clear error.
+
+    Raises
+    ------
+    OptionError
+        Naming the option, the rule and the value.
     """
     base = dict(full, **quick_defaults) if quick else dict(full)
     unknown = [k for k in given if k not in base]
     if unknown:
         raise TypeError(f"unknown study options {unknown}; known: {sorted(base)}")
-    return {k: (given[k] if given.get(k) is not None else v) for k, v in base.items()}
+    out = {k: (given[k] if given.get(k) is not None else v) for k, v in base.items()}
+    for k, value in out.items():
+        if k in unchecked:
+            continue
+        for x in _numbers(value):
+            if not math.isfinite(x) or x < 0 or (x == 0 and k not in zero_allowed):
+                rule = "non-negative (0: none)" if k in zero_allowed else "positive"
+                raise OptionError(f"`{k}` (--{k.replace('_', '-')}) must be {rule} and finite, got {value!r}.")
+    return out

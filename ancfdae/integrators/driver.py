@@ -87,6 +87,8 @@ def output_times(t_span: tuple[float, float],
                  t_eval: ArrayLike | None) -> tuple[float, float, np.ndarray | None]:
     """Validate ``t_span = (t0, tf)`` and ``t_eval``; return ``(t0, tf, t_out or None)``."""
     try:
+        if isinstance(t_span, (str, bytes)) or any(isinstance(x, (str, bytes)) for x in t_span):
+            raise TypeError("text")     # float("1") would accept it: times are numbers
         t0, tf = (float(x) for x in t_span)
     except (TypeError, ValueError):
         raise ValueError(f"`t_span` must be a pair (t0, tf) of numbers, got {t_span!r}.") from None
