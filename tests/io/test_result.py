@@ -69,6 +69,7 @@ def test_round_trip_every_integrator(tmp_path, method, h):
 def test_round_trip_every_element_with_model_description(tmp_path, element_cls, options):
     beam = _beam(element_cls, **options)
     res = simulate(beam, (0, 0.02), "lobatto3", h=0.005, monitors=[EnergyMonitor()])
+    assert res.success, res.message
     assert res.model["element"]["type"] == element_cls.name
     if element_cls is BE3D:   # the nodal directors, one row per output, recorded by the driver
         assert res.model_state["directors"].shape == (res.t.size, beam.n_nodes, 3)
