@@ -16,6 +16,7 @@ import numpy as np
 
 from typing import TYPE_CHECKING
 
+from . import _validate as validate
 from ._sections import output_directors, reference_points, section_outline, solid_points, wedge_cells
 
 if TYPE_CHECKING:
@@ -111,8 +112,8 @@ def vtk(result: Result, beam: Beam | None = None, directory: str | os.PathLike =
         raise ValueError(f"`beam` has {beam.n_dof} coordinates, `result` {result.q.shape[1]}.")
     if isinstance(every, bool) or not isinstance(every, int) or every < 1:
         raise ValueError(f"`every` must be a positive integer, got {every!r}.")
-    directory = Path(directory)
-    directory.mkdir(parents=True, exist_ok=True)
+    directory = validate.output_folder("directory", directory)
+    name = validate.file_stem("name", name)
     outline = section_outline(beam.element.section)
     cells = [("wedge", wedge_cells(beam.n_nodes, len(outline)))]
     per_node = 1 + len(outline)

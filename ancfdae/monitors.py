@@ -133,6 +133,10 @@ class EnergyMonitor(Monitor):
     ``"constraints"``) ``W_ext`` includes the work of the forces that drive prescribed motions,
     ``int lam . g_t dt`` with ``lam`` from the KKT system at the quadrature nodes
     (:func:`ancfdae.constrained.constraint_power`); scleronomic joints do no work.
+
+    ``log()`` adds the scalars ``max_abs_drift`` and ``scale`` (over the finite output rows),
+    ``relative_drift = max_abs_drift / scale`` -- ``inf`` when an energy overflowed or became
+    NaN, never a finite number computed around the overflow --, ``blow_up`` and ``t_blow_up``.
     """
 
     def __init__(self, name: str = "energy", blowup: float = 0.1, stop_on_blowup: bool = False) -> None:
@@ -199,10 +203,15 @@ class EnergyMonitor(Monitor):
         rows = np.array(self._rows, dtype=float).reshape(-1, 7)
         keys = ("kinetic", "strain", "potential", "work", "total", "balance", "drift")
         out = {k: rows[:, i].copy() for i, k in enumerate(keys)}
-        finite = out["drift"][np.isfinite(out["drift"])]
-        max_drift = float(np.max(np.abs(finite))) if finite.size else float("nan")
-        out.update(max_abs_drift=max_drift, scale=float(self._scale),
-                   relative_drift=max_drift / self._scale if self._scale > 0 else float("nan"),
+        finite = np.all(np.isfinite(rows), axis=1)
+        drift = np.abs(out["drift"][finite])
+        max_drift = float(np.max(drift)) if drift.size else float("nan")
+        # the scale of the rows that are finite: an overflow (inf energies) must not divide the drift to 0
+        scale = float(np.max(np.abs(rows[finite, :3]).sum(axis=1) + np.abs(rows[finite, 3]))) if drift.size else 0.0
+        relative = max_drift / scale if scale > 0 else float("nan")
+        if not np.all(finite):
+            relative = float("inf")         # the energy itself overflowed: no finite drift describes that
+        out.update(max_abs_drift=max_drift, scale=scale, relative_drift=relative,
                    blow_up=self._blow is not None, t_blow_up=self._blow)
         return out
 
@@ -273,7 +282,9 @@ class Probe(Monitor):
     name : str
         Key in ``Result.monitors``.
     function : callable
-        ``function(t, q, v, a) -> array``, logged as ``"value"``.
+        ``function(t, q, v, a) -> array``, logged as ``"value"``: numbers of the same shape at every
+        output time (a changed shape ends the run as failed, naming the probe). Non-finite values
+        are logged as they are (a probe may report "undefined" as NaN).
     """
 
     def __init__(self, name: str, function: Callable) -> None:
@@ -286,7 +297,16 @@ class Probe(Monitor):
         self._rows = []
 
     def sample(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> None:
-        self._rows.append(np.asarray(self.function(t, q, v, a), dtype=float))
+        value = self.function(t, q, v, a)
+        try:
+            row = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f"Probe {self.name!r}: `function` returned {value!r:.80} at t = {t:.9g}, not numbers "
+                             "(an array of floats)") from None
+        if self._rows and row.shape != self._rows[0].shape:
+            raise ValueError(f"Probe {self.name!r}: `function` returned shape {row.shape} at t = {t:.9g}, "
+                             f"{self._rows[0].shape} before; its value must keep its shape")
+        self._rows.append(row)
 
     def log(self) -> dict:
         return {"value": np.array(self._rows)}

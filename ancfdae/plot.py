@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from . import _validate as validate
 from ._sections import output_directors, section_outline, section_vectors
 from .export import beam_of
 
@@ -207,7 +208,9 @@ def animate(result: Result, path: str | os.PathLike, *, beam: Beam | None = None
         raise ValueError(f"`every` must be a positive integer, got {every!r}.")
     if result.t.size == 0:
         raise ValueError("`result` has no outputs to animate.")
-    path = Path(path)
+    fps = validate.positive_int("fps", fps)
+    dpi = validate.positive_int("dpi", dpi)
+    path = validate.output_file("path", path, (".gif",))
     directors = output_directors(result, beam)
     frames = range(0, result.t.size, every)
     fig = Figure(figsize=(6, 4))

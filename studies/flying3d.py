@@ -251,7 +251,8 @@ def run(be_meshes=None, sq_meshes=None, variants=None, variant_mesh=None, method
     """
     o = settings(FULL, QUICK, quick, dict(be_meshes=be_meshes, sq_meshes=sq_meshes, variants=variants,
                                           variant_mesh=variant_mesh, methods=methods, long_run=long_run, t_end=t_end,
-                                          t_end_sq=t_end_sq, h=h, dt_out=dt_out, em_run=em_run))
+                                          t_end_sq=t_end_sq, h=h, dt_out=dt_out, em_run=em_run),
+                 zero_allowed=("long_run", "em_run"))
     unknown = [m for m in o["methods"] if m not in METHODS]
     if unknown:
         raise OptionError(f"`methods` must be keys of {sorted(METHODS)}, got {unknown}.")

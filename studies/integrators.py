@@ -151,7 +151,8 @@ def run(models=None, element=None, n=None, t_end=None, dt_out=None, steps=None, 
     """
     o = settings(FULL, QUICK, quick, dict(models=models, element=element, n=n, t_end=t_end, dt_out=dt_out,
                                           steps=steps, rtols=rtols, newton_tols=newton_tols, methods=methods,
-                                          h_ref=h_ref))
+                                          h_ref=h_ref),
+                 zero_allowed=("rtols", "newton_tols"))
     unknown = [m for m in o["methods"] if m not in METHODS]
     if unknown:
         raise OptionError(f"`methods` must be keys of {list(METHODS)}, got {unknown}.")

@@ -8,6 +8,7 @@ scikit-sundae imported lazily). Each is a stepper run by the one driver (:func:`
 :class:`FixedStepIntegrator` (one ``_step_impl`` on the uniform grid) or :class:`NewtonStepper`
 (and a Newton solve per step) for a method of your own.
 """
+from ancfdae.integrators._checks import RunInterrupted
 from ancfdae.integrators._newton_records import NewtonOptions
 from ancfdae.integrators.driver import integrate
 from ancfdae.integrators.energy_momentum import EnergyMomentum
@@ -21,4 +22,4 @@ from ancfdae.integrators.protocol import Quadrature, StepOutcome
 
 __all__ = ["Integrator", "FixedStepIntegrator", "NewtonStepper", "StepOutcome", "Quadrature", "NewtonOptions",
            "LobattoIIIA", "Lobatto3", "Lobatto2", "ButcherTableau", "LOBATTO_IIIA_2", "LOBATTO_IIIA_3", "Newmark",
-           "HHTAlpha", "GeneralizedAlpha", "EnergyMomentum", "IDA", "integrate"]
+           "HHTAlpha", "GeneralizedAlpha", "EnergyMomentum", "IDA", "integrate", "RunInterrupted"]
