@@ -121,7 +121,6 @@ class IDA(Integrator):
     name = "ida"
     order = None
     fixed_step = False
-    consistent_restart = True
 
     def __init__(self, model: Model, rtol: float = 1e-6, atol: float | ArrayLike | None = None, *,
                  max_order: int = 5, max_step: float = 0.0, first_step: float = 0.0,
@@ -275,7 +274,7 @@ class IDA(Integrator):
         Parameters
         ----------
         t, q, v, a, model
-            As for :meth:`~ancfdae.integrators.Integrator.restart` (``a`` consistent: ``consistent_restart``).
+            As for :meth:`~ancfdae.integrators.Integrator.restart`.
         """
         super().restart(t, q, v, a, model)
         self._solver.init_step(float(t), *self._join(q, v, a))

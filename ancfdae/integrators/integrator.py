@@ -66,7 +66,6 @@ class Integrator(ABC):
     name: str = "integrator"
     order: int | None = None
     fixed_step: bool = True
-    consistent_restart: bool = False
 
     def __init__(self, model: Model, h: float | None = None) -> None:
         self.n_dof = check_model(model)
@@ -153,7 +152,7 @@ class Integrator(ABC):
         t : float
             Time of the event.
         q, v, a : ndarray
-            The changed state (``a`` consistent when ``consistent_restart``, else the step's own).
+            The changed state; ``a`` is consistent with it and with ``model`` (the driver solves for it).
         model : Model
             The model bound to the event's new state; evaluated from now on (counters carry on).
         """
