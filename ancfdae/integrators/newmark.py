@@ -31,6 +31,7 @@ import numbers
 
 from ancfdae.integrators._affine import affine2, affine3, newmark_predict
 from ancfdae.integrators._newton_records import NewtonOptions
+from ancfdae.integrators.driver import consistent_acceleration
 from ancfdae.integrators.newton_stepper import NewtonStepper
 from ancfdae.integrators.protocol import StepOutcome
 from ancfdae.problem import Model
@@ -64,6 +65,28 @@ class _AlphaFamily(NewtonStepper):
         o = super().options()
         o.update(beta=self.beta, gamma=self.gamma, alpha_m=self.alpha_m, alpha_f=self.alpha_f)
         return o
+
+    def restart(self, t, q, v, a, model) -> None:
+        """Carry on after a model event, keeping the algorithmic acceleration's offset.
+
+        For ``am, af != 0`` the carried ``a`` is the algorithmic acceleration, which differs from the
+        physical one by O(h); the event changes the physical part only, so the stepper restarts with
+        ``a + (a_alg - a_old)``, ``a_old`` the physical acceleration of the model before the event at the
+        state before it (one more mass solve). Restarting with ``a`` itself resets the offset at every
+        event: on B3 (BE3D, 8 elements, update every step, ``rho_inf = 0.8``, h = 1e-3 s) that put
+        -5.7e-5 J into the balance in 2 s where keeping it leaves 8.6e-7 J, the method's own error.
+
+        Parameters
+        ----------
+        t, q, v, a, model
+            As for :meth:`~ancfdae.integrators.Integrator.restart` (``a`` consistent with ``model``).
+        """
+        if self.alpha_m != 0.0 or self.alpha_f != 0.0:
+            a_old, reason = consistent_acceleration(self.model, t, self.q, self.v)
+            if a_old is None:
+                raise FloatingPointError(f"the acceleration before the model event failed: {reason}")
+            a = a + (self.a - a_old)
+        super().restart(t, q, v, a, model)
 
     def _step_impl(self, t, h):
         am, af, b, g, model = self.alpha_m, self.alpha_f, self.beta, self.gamma, self.model
