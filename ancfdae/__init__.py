@@ -14,7 +14,7 @@ from .problem import Energy, JacobianBlocks, Model
 from .static import StaticResult, solve_static
 from .simulate import METHODS, simulate
 from .result import Result, ResultFileError
-from .monitors import EnergyMonitor, PointSensor, Probe
+from .monitors import DirectorGeometry, EnergyMonitor, PointSensor, Probe
 
 __version__ = "0.1.0"
 
@@ -27,5 +27,5 @@ __all__ = [
     "PointForce", "PointMoment", "Gravity", "DistributedLoad", "constant", "ramp", "pulse", "hat",
     "Model", "JacobianBlocks", "Energy",
     "solve_static", "StaticResult",
-    "simulate", "METHODS", "Result", "ResultFileError", "EnergyMonitor", "PointSensor", "Probe",
+    "simulate", "METHODS", "Result", "ResultFileError", "EnergyMonitor", "PointSensor", "Probe", "DirectorGeometry",
 ]

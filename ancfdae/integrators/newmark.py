@@ -29,6 +29,8 @@ from __future__ import annotations
 
 import numbers
 
+import numpy as np
+
 from ancfdae.integrators._affine import affine2, affine3, newmark_predict
 from ancfdae.integrators._newton_records import NewtonOptions
 from ancfdae.integrators.driver import consistent_acceleration
@@ -66,7 +68,7 @@ class _AlphaFamily(NewtonStepper):
         o.update(beta=self.beta, gamma=self.gamma, alpha_m=self.alpha_m, alpha_f=self.alpha_f)
         return o
 
-    def restart(self, t, q, v, a, model) -> None:
+    def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model) -> None:
         """Carry on after a model event, keeping the algorithmic acceleration's offset.
 
         For ``am, af != 0`` the carried ``a`` is the algorithmic acceleration, which differs from the
