@@ -140,6 +140,10 @@ class Model(Protocol):
 #:     stages of a Runge-Kutta step in one call (Lobatto IIIA).
 #: ``"variable_mass"``
 #:     ``M`` depends on ``q`` (then ``mass_is_constant`` must be False); no extra method.
+#: ``"mass_forms"``
+#:     with ``"variable_mass"``: ``mass_action(q, x, tangent) -> (M(q) x, d(M x)/dq or None)`` and
+#:     ``mass_bilinear(q, u, w, order) -> (B, dB/dq, d2B/dq2)`` of ``B = u^T M(q) w / 2`` (the
+#:     energy-momentum integrator's discrete gradient of a configuration-dependent kinetic energy).
 #: ``"step_events"``
 #:     the model has an *event state* (a dict of arrays, e.g. BE3D's nodal directors) that may change
 #:     between steps: ``event_state() -> dict`` (the initial state), ``bind(state) -> Model`` (a model
@@ -168,6 +172,7 @@ CAPABILITIES: dict[str, tuple[str, ...]] = {
     "residual_jacobian": ("residual_jacobian",),
     "residual_stages": ("residual_stages",),
     "variable_mass": (),
+    "mass_forms": ("mass_action", "mass_bilinear"),
     "step_events": ("event_state", "bind", "step_event"),
     "potential": ("potential", "potential_gradient", "nonconservative_force"),
     "constraints": ("constraints", "constraint_jacobian", "constraint_force_jacobian", "constraint_rates"),

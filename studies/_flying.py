@@ -114,7 +114,7 @@ def output_times(t_end: float, dt_out: float) -> np.ndarray:
 
 def simulate_case(beam, t_end: float, method: str = "lobatto3", h: float | None = 1e-3, dt_out: float = 0.01,
                   newton: dict | None = None, energy: bool = True, stop_on_blowup: bool = False,
-                  **options) -> dict:
+                  monitors: tuple = (), **options) -> dict:
     """Integrate ``beam`` over ``[0, t_end]``; return the run's record.
 
     Parameters
@@ -134,6 +134,8 @@ def simulate_case(beam, t_end: float, method: str = "lobatto3", h: float | None 
         Log the energy balance (costs a few external-power evaluations per step).
     stop_on_blowup : bool
         End the run when the energy monitor flags a blow-up (10 % drift).
+    monitors : tuple of Monitor
+        Logged beside the tip and the energy (e.g. :class:`ancfdae.DirectorGeometry`).
 
     Returns
     -------
@@ -144,7 +146,7 @@ def simulate_case(beam, t_end: float, method: str = "lobatto3", h: float | None 
         analyses use.
     """
     t_eval = output_times(t_end, dt_out)
-    monitors = [PointSensor(s=0.0, name="tip")]
+    monitors = [PointSensor(s=0.0, name="tip"), *monitors]
     if energy:
         monitors.append(EnergyMonitor(stop_on_blowup=stop_on_blowup))
     if method != "ida" and not (method == "energy-momentum" and newton is None):

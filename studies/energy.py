@@ -134,8 +134,6 @@ def run(elements=None, integrators=None, n: int | None = None, t_end_b2=None, t_
         for integ in o["integrators"]:
             if name == "BE3D" and integ == "ida":
                 continue   # the director update restarts IDA after every step (BDF history lost): hours
-            if name == "BE3D" and integ == "energy-momentum":
-                continue   # needs a constant mass matrix; BE3D's rotary inertia depends on the slopes
             c = {"element": name, "n": o["n"] or n_default, "problem": problem, "integrator": integ, "h": o["h"],
                  "t_end": o["t_end_b2"] if problem == "B2" else o["t_end_b3"], "dt_out": o["dt_out"]}
             cost = c["t_end"] * c["n"] * (1 if name == "BE2D" else 3 if name in ("SQ2D", "BE3D") else 10)

@@ -4,7 +4,8 @@
 the consistent initial acceleration, output times (grid hits and the stepper's interpolation inside
 a step), monitors (each step's :class:`~.protocol.Quadrature` is passed to ``Monitor.advance``),
 hooks, model events (the ``"step_events"`` capability of :mod:`ancfdae.problem`: BE3D's director
-update), failure handling and the :class:`~ancfdae.result.Result` with the model's description.
+update; after each the stepper restarts with the acceleration consistent with the changed state and
+model, one mass solve per event), failure handling and the :class:`~ancfdae.result.Result` with the model's description.
 It hands the stepper everything through arguments: ``initialize(model, t0, q0, v0, a0, t_bound,
 want_quadrature=...)`` and ``restart(t, q, v, a, model)``. It needs only the :mod:`.protocol`, so
 the stepper base (:mod:`.integrator`, whose ``run`` calls this driver) stands above it.
@@ -305,12 +306,13 @@ def integrate(stepper: Stepper, model: Model, t_span: tuple[float, float], t_eva
                     q_e, v_e, state = ev
                     events_n += 1
                     bound = model.bind(state)
-                    a_e = stepper.a
-                    if getattr(stepper, "consistent_restart", False):
-                        a_e, reason = consistent_acceleration(bound, t, q_e, v_e)
-                        if a_e is None:
-                            raise _Failed(f"acceleration after the model event at t = {t:.9g} failed: {reason}")
-                    stepper.restart(t, np.asarray(q_e, float), np.asarray(v_e, float), a_e, bound)
+                    q_e, v_e = np.asarray(q_e, float), np.asarray(v_e, float)
+                    # the step's own acceleration belongs to the old state and model (a remapped
+                    # torsion rate, a new director field): one mass solve gives the consistent one
+                    a_e, reason = consistent_acceleration(bound, t, q_e, v_e)
+                    if a_e is None:
+                        raise _Failed(f"acceleration after the model event at t = {t:.9g} failed: {reason}")
+                    stepper.restart(t, q_e, v_e, a_e, bound)
                     restarts += 1
                     rec.rebind(bound)
             if on_grid:

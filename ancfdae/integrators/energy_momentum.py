@@ -71,10 +71,12 @@ What holds exactly (to round-off and the Newton tolerance)
   forces enter through the midpoint Jacobian ``G(q_m)``, an exact discrete derivative for rows at most
   quadratic in ``q`` (``constraint_degree <= 2``, refused otherwise); energy is kept and ``g(t1, q1) = 0``
   holds to round-off (:mod:`ancfdae.integrators._em_constrained`).
-* BE3D: not supported. Its mass matrix depends on the slopes (the rotary inertia of the
-  cross-section), so the kinetic energy is not ``v^T M v / 2`` with a constant ``M`` and the
-  midpoint velocity update no longer yields the energy identity; a discrete gradient of its
-  Hamiltonian in the momenta is not implemented. The constructor raises a ValueError.
+* BE3D, BE3DSR (mass matrix depending on the slopes: the rotary inertia of the cross-section):
+  the kinetic part of :mod:`._kinetic_gradient` (a discrete gradient of ``B = v0^T M(q) v1 / 2``)
+  keeps the energy identity; between director updates the energy is kept to round-off, so the
+  updates' jumps are the only change of the balance. No momentum is claimed; the Gonzalez
+  gradient of the potential is corrected off the translations only. A model with a variable
+  mass needs the ``"mass_forms"`` capability (:mod:`ancfdae.problem`), else a ValueError.
 """
 from __future__ import annotations
 
@@ -88,6 +90,7 @@ from ancfdae.integrators._alpha_index3 import mass_scale
 from ancfdae.integrators._discrete_gradient import AVFGradient, GonzalezGradient
 from ancfdae.integrators._em_constrained import constrained_em_step
 from ancfdae.kkt import KKTAssembler
+from ancfdae.integrators._kinetic_gradient import KineticPart
 from ancfdae.integrators._newton_records import NewtonOptions
 from ancfdae.integrators.newton_stepper import NewtonStepper
 from ancfdae.integrators.protocol import Quadrature, StepOutcome
@@ -138,12 +141,12 @@ class EnergyMomentum(NewtonStepper):
 
     def __init__(self, model: Model, h: float, *, discrete_gradient: str = "auto", angular_momentum: bool = True,
                  newton: NewtonOptions | dict | None = None) -> None:
-        if not getattr(model, "mass_is_constant", False):
-            raise ValueError("`model` must have a constant mass matrix for method 'energy-momentum' "
-                             f"(mass_is_constant=True), got {type(model).__name__} with mass_is_constant=False "
-                             "(BE3D: the cross-section's rotary inertia depends on the slopes, so the kinetic "
-                             "energy is not quadratic in v with a constant matrix and the scheme's energy "
-                             "identity does not hold).")
+        self.variable_mass = not getattr(model, "mass_is_constant", False)
+        if self.variable_mass and "mass_forms" not in capabilities(model):
+            raise ValueError("`model` must have a constant mass matrix (mass_is_constant=True) or declare the "
+                             "'mass_forms' capability (mass_action, mass_bilinear) for method 'energy-momentum'; "
+                             f"{type(model).__name__} has mass_is_constant=False and declares "
+                             f"{sorted(capabilities(model))}.")
         if "potential" not in capabilities(model):
             raise ValueError("`model` must declare the 'potential' capability (ancfdae.problem.PotentialModel: "
                              "potential, potential_gradient, nonconservative_force) for method "
@@ -179,7 +182,9 @@ class EnergyMomentum(NewtonStepper):
         self._Mlu = spla.splu(sp.csc_matrix(self._M))
         degree = getattr(model, "potential_degree", None)
         self._dg = (AVFGradient(self.model, degree) if self.discrete_gradient == "avf"
-                    else GonzalezGradient(self.model, self._M, rotations=self.angular_momentum))
+                    else GonzalezGradient(self.model, self._M,
+                                          rotations=self.angular_momentum and not self.variable_mass))
+        self._kin = KineticPart(self.model, self._M) if self.variable_mass else None
 
     def _setup(self):
         """The driver may hand another model instance: bind it; check the residual split."""
@@ -210,7 +215,7 @@ class EnergyMomentum(NewtonStepper):
         """The scheme integrates ``M a + grad P - f_nc``; refuse a model whose residual has more
         (damping, velocity-dependent loads), which the scheme would silently drop."""
         m = self.model
-        probe = v + 1.0                                     # a velocity-dependent force must show
+        probe = 0 * v if self.variable_mass else v + 1.0   # a velocity-dependent force must show (constant M)
         r = np.asarray(m.residual(t, q, probe, np.zeros_like(q)), dtype=float)
         split = m.potential_gradient(t, q, False)[0] - m.nonconservative_force(t, q, False)[0]
         scale = max(float(np.max(np.abs(r), initial=0.0)), float(np.max(np.abs(split), initial=0.0)), 1e-300)
@@ -227,9 +232,11 @@ class EnergyMomentum(NewtonStepper):
             return constrained_em_step(self, t0, h)
         q0, v0 = self.q, self.v
         tm, t1 = t0 + 0.5 * h, t0 + h
-        model, dg, M, c = self.model, self._dg, self._M, 2.0 / (h * h)
+        model, dg, M, c, kin = self.model, self._dg, self._M, 2.0 / (h * h), self._kin
         dg.start(tm, q0)
         hv0 = h * v0
+        if kin is not None:
+            kin.start(q0, v0, h)
 
         # Unknown: y = q1 - q0 - h v0 (the step's deviation from the free flight, O(h^2)). Then
         # v1 - v0 = 2 y / h is formed from y, not from q1 - q0: the energy identity's error is
@@ -238,13 +245,16 @@ class EnergyMomentum(NewtonStepper):
         def residual(y):
             u = hv0 + y
             f, _ = model.nonconservative_force(tm, q0 + 0.5 * u, False)
-            return c * (M @ y) + dg.gradient(q0 + u) - f
+            inertia = kin.residual(y) if kin is not None else c * (M @ y)
+            return inertia + dg.gradient(q0 + u) - f
 
         def jacobian(y):
             u = hv0 + y
             _, Kf = model.nonconservative_force(tm, q0 + 0.5 * u, True)
             J = dg.jacobian(q0 + u)
             floor = self.floor_of(J, q0 + u)      # dG/dq plays the stiffness' part
+            if kin is not None:
+                return (J.toarray() if sp.issparse(J) else J) + kin.jacobian(y) - 0.5 * Kf.toarray(), floor
             if sp.issparse(J):
                 return sp.csr_matrix(c * M + J - 0.5 * Kf), floor
             return J + (c * M - 0.5 * Kf).toarray(), floor
@@ -256,7 +266,8 @@ class EnergyMomentum(NewtonStepper):
         q1 = q0 + (hv0 + y)
         v1 = v0 + (2.0 / h) * y
         # The acceleration at t1 (for interpolation and the next predictor): M a1 = -r(t1, q1, v1, 0).
-        a1 = self._Mlu.solve(-np.asarray(model.residual(t1, q1, v1, np.zeros_like(q1)), dtype=float))
+        r1 = -np.asarray(model.residual(t1, q1, v1, np.zeros_like(q1)), dtype=float)
+        a1 = spla.splu(sp.csc_matrix(model.mass(q1))).solve(r1) if kin is not None else self._Mlu.solve(r1)
         if not np.all(np.isfinite(a1)):
             return StepOutcome.failure(f"the acceleration at t = {t1:.9g} is not finite (the model's residual there)")
         quad = None

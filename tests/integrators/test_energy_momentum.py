@@ -11,7 +11,7 @@ from ancfdae import Material, PointForce, PointMoment, RectangularSection, hat, 
 from ancfdae.integrators._discrete_gradient import AVFGradient, GonzalezGradient
 from ancfdae.integrators.energy_momentum import EnergyMomentum
 from ancfdae.monitors import EnergyMonitor
-from support.toy_models import SpringChain
+from support.toy_models import DoublePendulum, SpringChain
 
 MAT = Material(E=1e5, nu=0.3, rho=2500.0)
 SEC = RectangularSection(0.05)
@@ -206,10 +206,11 @@ def test_observed_order_two():
     assert abs(slope - 2.0) < 0.15, (slope, errs)
 
 
-def test_be3d_refused_with_reason():
-    beam = b3("BE3D", 2)
-    with pytest.raises(ValueError, match="constant mass matrix"):
-        EnergyMomentum(beam, 1e-2)
+def test_variable_mass_without_its_forms_refused_with_reason():
+    """A configuration-dependent mass needs mass_action and mass_bilinear (BE3D has them: see
+    test_energy_momentum_variable_mass.py)."""
+    with pytest.raises(ValueError, match="'mass_forms' capability"):
+        EnergyMomentum(DoublePendulum(), 1e-2)
 
 
 def test_bad_options():
