@@ -82,9 +82,10 @@ from ancfdae import _validate as validate
 from ancfdae._scale import ENERGY_ROUNDOFF
 from ancfdae.integrators._discrete_gradient import AVFGradient, GonzalezGradient
 from ancfdae.integrators._newton_records import NewtonOptions
+from ancfdae.integrators._potential_split import require_potential_model, require_potential_split
 from ancfdae.integrators.newton_stepper import NewtonStepper
 from ancfdae.integrators.protocol import Quadrature, StepOutcome
-from ancfdae.problem import Model, capabilities
+from ancfdae.problem import Model
 
 __all__ = ["EnergyMomentum", "DISCRETE_GRADIENTS", "DEFAULT_NEWTON"]
 
@@ -130,17 +131,7 @@ class EnergyMomentum(NewtonStepper):
 
     def __init__(self, model: Model, h: float, *, discrete_gradient: str = "auto", angular_momentum: bool = True,
                  newton: NewtonOptions | dict | None = None) -> None:
-        if not getattr(model, "mass_is_constant", False):
-            raise ValueError("`model` must have a constant mass matrix for method 'energy-momentum' "
-                             f"(mass_is_constant=True), got {type(model).__name__} with mass_is_constant=False "
-                             "(BE3D: the cross-section's rotary inertia depends on the slopes, so the kinetic "
-                             "energy is not quadratic in v with a constant matrix and the scheme's energy "
-                             "identity does not hold).")
-        if "potential" not in capabilities(model):
-            raise ValueError("`model` must declare the 'potential' capability (ancfdae.problem.PotentialModel: "
-                             "potential, potential_gradient, nonconservative_force) for method "
-                             f"'energy-momentum'; {type(model).__name__} declares "
-                             f"{sorted(capabilities(model))}.")
+        require_potential_model(model, "energy-momentum")
         super().__init__(model, h, newton=DEFAULT_NEWTON if newton is None else newton)
         validate.choice("discrete_gradient", discrete_gradient, DISCRETE_GRADIENTS)
         degree = getattr(model, "potential_degree", None)
@@ -173,7 +164,7 @@ class EnergyMomentum(NewtonStepper):
         super()._setup()
         if self.model.wrapped is not self._model_bound:
             self._bind(self.model.wrapped)
-        self._check_split(self.t, self.q, self.v)
+        require_potential_split(self.model, self.t, self.q, self.v, "energy-momentum")
 
     def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model) -> None:
         """Carry on from a state a model event changed (grid and Newton matrix kept; a new model rebound).
@@ -186,20 +177,6 @@ class EnergyMomentum(NewtonStepper):
         super().restart(t, q, v, a, model)
         if self.model.wrapped is not self._model_bound:
             self._bind(self.model.wrapped)
-
-    def _check_split(self, t, q, v):
-        """The scheme integrates ``M a + grad P - f_nc``; refuse a model whose residual has more
-        (damping, velocity-dependent loads), which the scheme would silently drop."""
-        m = self.model
-        probe = v + 1.0                                     # a velocity-dependent force must show
-        r = np.asarray(m.residual(t, q, probe, np.zeros_like(q)), dtype=float)
-        split = m.potential_gradient(t, q, False)[0] - m.nonconservative_force(t, q, False)[0]
-        scale = max(float(np.max(np.abs(r), initial=0.0)), float(np.max(np.abs(split), initial=0.0)), 1e-300)
-        err = float(np.max(np.abs(r - split), initial=0.0))
-        if err > 1e-8 * scale:
-            raise ValueError("`model` residual must be M a + dP/dq - f_nc(t, q) for method 'energy-momentum'; "
-                             f"at t = {t:g} it differs from the PotentialModel split by {err:.3g} "
-                             f"(scale {scale:.3g}): damping or velocity-dependent forces are not supported.")
 
     # -- one step ------------------------------------------------------------------------
     def _step_impl(self, t0, h):
