@@ -14,19 +14,22 @@ Gauss rule, ``k >= 2`` (the *silent stages*), instead of collocating at 2 points
 the energy-preserving variant of collocation: Hairer, JNAIAM 5:73, 2010; the notation in
 :mod:`ancfdae.integrators._hbvm_coefficients`). The unknowns are the two Legendre coefficients of the
 acceleration, ``2 n_dof`` numbers as for Lobatto IIIA-3; only the number of force evaluations per
-residual grows with ``k``.
+residual grows with ``k``. Only the conservative force ``grad P`` needs the ``k`` nodes: the loads
+``f_nc`` are projected with the 2-point Gauss rule (``k = 2``, the Gauss method's own rule, order 4),
+which on B2 halves the cost of a residual (BE2D's dead moment depends on the slopes and is evaluated
+per node in Python, several times the compiled internal forces).
 
 What holds
 ----------
 * Order 4 in ``q`` and ``v`` (``2 s``), symmetric, for every ``k >= 2``.
-* Energy: ``T1 - T0 + P1 - P0 = h sum_l b_l f_nc(t_l, sigma_l) . sigma'_l`` whenever the ``k``-point
+* Energy: ``T1 - T0 + P1 - P0 = h sum_j b_j f_nc(t_j, sigma_j) . sigma'_j`` (2 Gauss nodes ``j``) whenever the ``k``-point
   rule integrates ``grad P(sigma(c)) . sigma'(c)`` exactly: for a polynomial ``P`` of degree
   ``nu <= k`` (``2 k / s``). The default ``k`` is therefore the declared ``potential_degree`` (4 for
   the St. Venant-Kirchhoff continuum formulations); for the other potentials (BE2D, Cable3D, the
   structural SQ formulations) :data:`SMOOTH_SILENT_STAGES`, where the energy error per step,
-  ``O(h^(2k+1))``, lies below round-off at the steps that resolve the motion. The step hands that
-  ``k``-point rule to the monitors (:class:`~ancfdae.integrators.Quadrature`: nodes ``t_l``,
-  ``sigma_l``, ``sigma'_l``, weights ``h b_l``), so ``T + U + V - W_ext`` is constant under loads.
+  ``O(h^(2k+1))``, lies below round-off at the steps that resolve the motion. The step hands the
+  loads' rule to the monitors (:class:`~ancfdae.integrators.Quadrature`: nodes ``t_j``, ``sigma_j``,
+  ``sigma'_j``, weights ``h b_j``), so ``T + U + V - W_ext`` is constant under loads.
 * Linear momentum ``T^T M v``: exact (the rule sums internal forces orthogonal to the translations).
   Angular momentum: not exact (the forces are evaluated off the configuration a rotation invariant
   needs); it drifts at the truncation error's size (``docs/energy_momentum.md``).
@@ -35,9 +38,10 @@ Newton
 ------
 Modified Newton on the shared solver, driven to round-off as the energy identity needs (the
 defaults of :data:`~ancfdae.integrators.energy_momentum.DEFAULT_NEWTON`). The exact Jacobian of the
-stage equations is ``dR_i/dY_m = delta_im M / h^2 + sum_l C[i, m, l] K_l`` with the stiffness ``K_l``
-at every node (real, ``2 n_dof`` square, interleaved, banded). The default iteration matrix freezes
-one stiffness, at the step's midpoint: then ``sum_l C[:, :, l] = X^2`` and the matrix splits in the
+stage equations is ``dR_i/dY_m = delta_im M / h^2 + sum_l C[i, m, l] H_l - sum_j C'[i, m, j] Kf_j`` with
+the Hessian ``H_l`` of ``P`` at every node and the load tangent ``Kf_j`` at the loads' nodes (real,
+``2 n_dof`` square, interleaved, banded). The default iteration matrix freezes
+one stiffness ``K`` of the residual, at the step's midpoint: then ``sum_l C[:, :, l] = X^2`` and the matrix splits in the
 eigenbasis of ``X`` (eigenvalues ``1/4 +- i / sqrt(48)``, those of Lobatto IIIA-3's implicit block)
 into one complex ``n_dof`` square banded LU, as Lobatto IIIA-3 (:class:`~ancfdae.integrators._linsolve.StageMatrix`).
 A step that fails with it is retried with the exact Jacobian; full Newton uses the exact Jacobian.
@@ -57,7 +61,7 @@ from ancfdae.integrators._potential_split import require_potential_model, requir
 from ancfdae.integrators.energy_momentum import DEFAULT_NEWTON
 from ancfdae.integrators.newton_stepper import NewtonStepper
 from ancfdae.integrators.protocol import Quadrature, StepOutcome
-from ancfdae.problem import JacobianBlocks, Model, capabilities
+from ancfdae.problem import JacobianBlocks, Model
 
 __all__ = ["EnergyCollocation", "SMOOTH_SILENT_STAGES", "ITERATION_MATRICES"]
 
@@ -148,6 +152,7 @@ class EnergyCollocation(NewtonStepper):
         self.silent_stages = k
         self.iteration_matrix = validate.choice("iteration_matrix", iteration_matrix, ITERATION_MATRICES)
         self._co = hbvm_coefficients(k, _S)
+        self._loads = hbvm_coefficients(_S, _S)      # the 2-point Gauss rule of the loads
         self._pattern = None
 
     def options(self) -> dict:
@@ -166,8 +171,8 @@ class EnergyCollocation(NewtonStepper):
         m = self.model
         self._M = sp.csr_matrix(m.mass(self.q))
         self._Mlu = spla.splu(sp.csc_matrix(self._M))
-        self._stages = "residual_stages" in capabilities(m)
-        self._zeros = np.zeros((self.n_dof, self._co.k))
+        z = np.zeros(self.n_dof)
+        self._Mcsr = sp.csr_matrix(m.jacobian(self.t, self.q, z, z).M)   # the mass on the stiffness' pattern
         self._prev = None          # (h, Y) of the last step: the predictor
 
     def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model) -> None:
@@ -176,37 +181,52 @@ class EnergyCollocation(NewtonStepper):
         self._bind()
 
     # -- the stage equations --------------------------------------------------------------------
-    def _forces(self, ts, Q):
-        """``-F = grad P - f_nc`` at the nodes (columns): the model's residual at zero velocity and acceleration."""
-        if self._stages:
-            return self.model.residual_stages(ts, Q, self._zeros, self._zeros)
-        z = self._zeros[:, 0]
-        return np.column_stack([self.model.residual(t, Q[:, l], z, z) for l, t in enumerate(ts)])
+    def _nodes(self, t0, h, Y, co):
+        """Times and positions ``sigma`` of the nodes of the rule ``co`` for the unknowns ``Y``."""
+        return t0 + co.c * h, self.q[:, None] + np.outer(h * self.v, co.c) + Y @ co.Wq.T
 
-    def _exact(self, blocks, h):
-        """The exact Jacobian ``delta_im M / h^2 + sum_l C[i, m, l] K_l``, interleaved CSR."""
-        co, n = self._co, self.n_dof
-        K0 = blocks[0].K
-        same = all(b.same_pattern and b.K.indptr is K0.indptr and b.K.indices is K0.indices for b in blocks) \
-            or all(b.same_pattern and np.array_equal(b.K.indptr, K0.indptr)
-                   and np.array_equal(b.K.indices, K0.indices) for b in blocks)
-        if same:
-            if self._pattern is None or self._pattern[0] is not K0.indptr or self._pattern[1] is not K0.indices:
-                self._pattern = (K0.indptr, K0.indices, *interleaved_pattern(K0.indptr, K0.indices, n, _S))
+    def _forces(self, t0, h, Y):
+        """``sum_l BP[i, l] (grad P - f_nc)(sigma_l)``: the conservative force at the ``k`` nodes, the
+        loads at the 2 Gauss nodes (the Gauss method's own rule: order 4, and the work of the loads is
+        that rule's, handed to the monitors)."""
+        m, co, ld = self.model, self._co, self._loads
+        ts, Q = self._nodes(t0, h, Y, co)
+        G = np.column_stack([m.potential_gradient(t, Q[:, l], False)[0] for l, t in enumerate(ts)])
+        ts, Q = self._nodes(t0, h, Y, ld)
+        F = np.column_stack([m.nonconservative_force(t, Q[:, l], False)[0] for l, t in enumerate(ts)])
+        return G @ co.BP.T - F @ ld.BP.T
+
+    def _exact(self, t0, h, Y):
+        """The exact Jacobian ``delta_im M / h^2 + sum_l C[i, m, l] H_l - sum_j Cnc[i, m, j] Kf_j`` (Hessians
+        ``H_l`` of ``P`` at the ``k`` nodes, load tangents ``Kf_j`` at the 2 Gauss nodes), interleaved CSR,
+        and the round-off floor of the largest Hessian."""
+        m, co, ld = self.model, self._co, self._loads
+        ts, Q = self._nodes(t0, h, Y, co)
+        H = [m.potential_gradient(t, Q[:, l], True)[1] for l, t in enumerate(ts)]
+        floor = max(self.floor_of(K, Q[:, l]) for l, K in enumerate(H))
+        ts, Q = self._nodes(t0, h, Y, ld)
+        Kf = [m.nonconservative_force(t, Q[:, l], True)[1] for l, t in enumerate(ts)]
+        return self._assemble(H, Kf, h), floor
+
+    def _assemble(self, H, Kf, h):
+        """``delta_im M / h^2 + sum_l C[i, m, l] H[l] - sum_j Cnc[i, m, j] Kf[j]`` as an interleaved CSR."""
+        co, ld, n = self._co, self._loads, self.n_dof
+        mats = [sp.csr_matrix(A) for A in list(H) + list(Kf)] + [self._Mcsr]
+        weights = np.concatenate([co.C, -ld.C, np.eye(_S)[:, :, None] / (h * h)], axis=2)   # (s, s, k + 2 + 1)
+        A0 = mats[0]
+        if all(A.indptr is A0.indptr and A.indices is A0.indices for A in mats) or all(
+                np.array_equal(A.indptr, A0.indptr) and np.array_equal(A.indices, A0.indices) for A in mats):
+            if self._pattern is None or not np.array_equal(self._pattern[0], A0.indptr) \
+                    or not np.array_equal(self._pattern[1], A0.indices):
+                self._pattern = (A0.indptr, A0.indices, *interleaved_pattern(A0.indptr, A0.indices, n, _S))
             _, _, order, big_indices, big_indptr = self._pattern
-            Kd = np.stack([b.K.data for b in blocks])                  # (k, nnz)
-            vals = np.einsum("iml,le->eim", co.C, Kd)                   # (nnz, s, s)
-            Md = blocks[0].M.data / (h * h)
-            for i in range(_S):
-                vals[:, i, i] += Md
+            vals = np.einsum("iml,le->eim", weights, np.stack([A.data for A in mats]))   # (nnz, s, s)
             return sp.csr_matrix((vals.ravel()[order], big_indices, big_indptr), shape=(_S * n, _S * n))
         out = None
         for i in range(_S):
-            for m in range(_S):
-                B = sum(co.C[i, m, l] * b.K for l, b in enumerate(blocks))
-                if i == m:
-                    B = B + self._M / (h * h)
-                E = sp.csr_matrix(([1.0], ([i], [m])), shape=(_S, _S))
+            for j in range(_S):
+                B = sum(w * A for w, A in zip(weights[i, j], mats))
+                E = sp.csr_matrix(([1.0], ([i], [j])), shape=(_S, _S))
                 term = sp.kron(B, E, format="csr")
                 out = term if out is None else out + term
         return out.tocsr()
@@ -217,14 +237,12 @@ class EnergyCollocation(NewtonStepper):
         ``split[0]`` is true, else the exact Jacobian."""
         co, n, model = self._co, self.n_dof, self.model
         q0, v0 = self.q, self.v
-        ts = t0 + co.c * h
-        base = q0[:, None] + np.outer(h * v0, co.c)                     # sigma at the nodes without Y
-        WqT, BPT, M, ih2 = co.Wq.T, co.BP.T, self._M, 1.0 / (h * h)
-        zn = self._zeros[:, 0]
+        M, ih2 = self._M, 1.0 / (h * h)
+        zn = np.zeros(n)
 
         def residual(x):
             Y = x.reshape(n, _S)
-            return (ih2 * (M @ Y) + self._forces(ts, base + Y @ WqT) @ BPT).ravel()
+            return (ih2 * (M @ Y) + self._forces(t0, h, Y)).ravel()
 
         def jacobian(x):
             Y = x.reshape(n, _S)
@@ -236,10 +254,7 @@ class EnergyCollocation(NewtonStepper):
                     blk = JacobianBlocks(K, sp.csr_matrix((np.zeros_like(K.data), K.indices, K.indptr),
                                                           shape=K.shape), blk.M, True)
                     return _SplitMatrix(blk, h, co.X), self.floor_of(K, qm)
-            Q = base + Y @ WqT
-            blocks = [model.jacobian(t, Q[:, l], zn, zn) for l, t in enumerate(ts)]
-            floor = max(self.floor_of(b.K, Q[:, l]) for l, b in enumerate(blocks))
-            return self._exact(blocks, h), floor
+            return self._exact(t0, h, Y)
 
         return residual, jacobian
 
@@ -269,9 +284,10 @@ class EnergyCollocation(NewtonStepper):
             return StepOutcome.failure(f"the acceleration at t = {t1:.9g} is not finite (the model's residual there)")
         self._prev = (h, Y)
         quad = None
-        if self.want_quadrature:     # the scheme's own rule: the energy balance is exact with it
-            quad = Quadrature(t=t0 + co.c * h, q=(q0[:, None] + np.outer(h * v0, co.c) + Y @ co.Wq.T).T,
-                              v=(v0[:, None] + (Y @ co.Wd.T) / h).T, w=h * co.b)
+        if self.want_quadrature:     # the loads' rule: the energy balance is exact with it
+            ld = self._loads
+            ts, Q = self._nodes(t0, h, Y, ld)
+            quad = Quadrature(t=ts, q=Q.T, v=(v0[:, None] + (Y @ ld.Wd.T) / h).T, w=h * ld.b)
         return StepOutcome(ok=True, t=t1, q=q1, v=v1, a=a1, quadrature=quad)
 
     def _predict(self, h):
