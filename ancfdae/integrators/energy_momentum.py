@@ -92,6 +92,7 @@ from ancfdae.integrators._em_constrained import constrained_em_step
 from ancfdae.kkt import KKTAssembler
 from ancfdae.integrators._kinetic_gradient import KineticPart
 from ancfdae.integrators._newton_records import NewtonOptions
+from ancfdae.integrators._potential_split import require_potential_model, require_potential_split
 from ancfdae.integrators.newton_stepper import NewtonStepper
 from ancfdae.integrators.protocol import Quadrature, StepOutcome
 from ancfdae.problem import Model, capabilities
@@ -142,16 +143,7 @@ class EnergyMomentum(NewtonStepper):
     def __init__(self, model: Model, h: float, *, discrete_gradient: str = "auto", angular_momentum: bool = True,
                  newton: NewtonOptions | dict | None = None) -> None:
         self.variable_mass = not getattr(model, "mass_is_constant", False)
-        if self.variable_mass and "mass_forms" not in capabilities(model):
-            raise ValueError("`model` must have a constant mass matrix (mass_is_constant=True) or declare the "
-                             "'mass_forms' capability (mass_action, mass_bilinear) for method 'energy-momentum'; "
-                             f"{type(model).__name__} has mass_is_constant=False and declares "
-                             f"{sorted(capabilities(model))}.")
-        if "potential" not in capabilities(model):
-            raise ValueError("`model` must declare the 'potential' capability (ancfdae.problem.PotentialModel: "
-                             "potential, potential_gradient, nonconservative_force) for method "
-                             f"'energy-momentum'; {type(model).__name__} declares "
-                             f"{sorted(capabilities(model))}.")
+        require_potential_model(model, "energy-momentum", variable_mass=True)
         if "constraints" in capabilities(model) and getattr(model, "constraint_degree", None) not in (1, 2):
             raise ValueError("`model` constraints must be at most quadratic in q (constraint_degree 1 or 2) for "
                              "method 'energy-momentum', whose midpoint constraint Jacobian is then an exact "
@@ -191,7 +183,8 @@ class EnergyMomentum(NewtonStepper):
         super()._setup()
         if self.model.wrapped is not self._model_bound:
             self._bind(self.model.wrapped)
-        self._check_split(self.t, self.q, self.v)
+        require_potential_split(self.model, self.t, self.q, self.v, "energy-momentum",
+                                variable_mass=self.variable_mass)
         self._constrained = "constraints" in capabilities(self.model)
         if self._constrained:
             self._mscale = mass_scale(self._M)
@@ -210,20 +203,6 @@ class EnergyMomentum(NewtonStepper):
         super().restart(t, q, v, a, model)
         if self.model.wrapped is not self._model_bound:
             self._bind(self.model.wrapped)
-
-    def _check_split(self, t, q, v):
-        """The scheme integrates ``M a + grad P - f_nc``; refuse a model whose residual has more
-        (damping, velocity-dependent loads), which the scheme would silently drop."""
-        m = self.model
-        probe = 0 * v if self.variable_mass else v + 1.0   # a velocity-dependent force must show (constant M)
-        r = np.asarray(m.residual(t, q, probe, np.zeros_like(q)), dtype=float)
-        split = m.potential_gradient(t, q, False)[0] - m.nonconservative_force(t, q, False)[0]
-        scale = max(float(np.max(np.abs(r), initial=0.0)), float(np.max(np.abs(split), initial=0.0)), 1e-300)
-        err = float(np.max(np.abs(r - split), initial=0.0))
-        if err > 1e-8 * scale:
-            raise ValueError("`model` residual must be M a + dP/dq - f_nc(t, q) for method 'energy-momentum'; "
-                             f"at t = {t:g} it differs from the PotentialModel split by {err:.3g} "
-                             f"(scale {scale:.3g}): damping or velocity-dependent forces are not supported.")
 
     # -- one step ------------------------------------------------------------------------
     def _step_impl(self, t0, h):
