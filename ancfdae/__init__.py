@@ -3,7 +3,8 @@
 The chapter cited throughout is Gerstmayr, Humer, Gruber, Nachbagauer, "The
 Absolute Nodal Coordinate Formulation" (Sects. 2-5, Eqs. 1-115).
 
-Submodules: :mod:`ancfdae.models` (elements and the beam), :mod:`ancfdae.integrators`,
+Submodules: :mod:`ancfdae.models` (elements and the beam), :mod:`ancfdae.bodies` (rigid bodies),
+:mod:`ancfdae.integrators`,
 :mod:`ancfdae.export` (ParaView), :mod:`ancfdae.plot` (matplotlib pictures and animations).
 """
 import logging
@@ -15,6 +16,7 @@ from .static import StaticResult, solve_static
 from .simulate import METHODS, simulate
 from .result import Result, ResultFileError
 from .monitors import EnergyMonitor, PointSensor, Probe
+from .bodies import RigidBody
 
 __version__ = "0.1.0"
 
@@ -28,4 +30,5 @@ __all__ = [
     "Model", "JacobianBlocks", "Energy",
     "solve_static", "StaticResult",
     "simulate", "METHODS", "Result", "ResultFileError", "EnergyMonitor", "PointSensor", "Probe",
+    "RigidBody",
 ]
