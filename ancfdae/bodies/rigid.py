@@ -12,9 +12,11 @@ a body-fixed point or director is at most quadratic in ``q``.
 from __future__ import annotations
 
 import numbers
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
+from numpy.typing import ArrayLike
 
 from .._validate import check_shape, finite_vector
 from ..attachment import Attachment
@@ -89,8 +91,10 @@ class RigidBody:
     mass_is_constant = True
     potential_degree = 1
 
-    def __init__(self, mass: float, inertia, position, orientation=None, *, com=None, velocity=None,
-                 angular_velocity=None, loads=(), name: str = "rigid body") -> None:
+    def __init__(self, mass: float, inertia: float | ArrayLike, position: ArrayLike,
+                 orientation: float | ArrayLike | None = None, *, com: ArrayLike | None = None,
+                 velocity: ArrayLike | None = None, angular_velocity: float | ArrayLike | None = None,
+                 loads: Any = (), name: str = "rigid body") -> None:
         x0 = finite_vector("position", position)
         dim = x0.shape[0]
         if dim not in (2, 3):
@@ -238,7 +242,7 @@ class RigidBody:
         return self._ortho.constraint_rates(t, q, v)
 
     # -- where joints take hold -----------------------------------------------------
-    def attachment(self, where=None) -> Attachment:
+    def attachment(self, where: ArrayLike | None = None) -> Attachment:
         """The body-fixed point ``where`` (body coordinates; default the reference point) and the directors.
 
         Returns
@@ -259,12 +263,12 @@ class RigidBody:
             raise ValueError(f"`q` must have shape (..., {self.n_dof}) (states of {self.name}), got {q.shape}.")
         return q
 
-    def orientation(self, q) -> np.ndarray:
+    def orientation(self, q: ArrayLike) -> np.ndarray:
         """Rotation matrices (columns: the directors) of one state (dim, dim) or many (n, dim, dim)."""
         q = self._states(q)
         return np.swapaxes(q[..., self.dim:].reshape(q.shape[:-1] + (self.dim, self.dim)), -1, -2)
 
-    def angular_velocity(self, q, v) -> np.ndarray:
+    def angular_velocity(self, q: ArrayLike, v: ArrayLike) -> np.ndarray:
         """Angular velocity in global coordinates, ``omega = 1/2 sum_k d_k x d_k_dot`` (exact for orthonormal
         directors); a scalar per state in 2D, a 3-vector in 3D."""
         R, Rd = self.orientation(q), self.orientation(v)
@@ -272,7 +276,7 @@ class RigidBody:
             return 0.5 * np.sum(R[..., 0, :] * Rd[..., 1, :] - R[..., 1, :] * Rd[..., 0, :], axis=-1)
         return 0.5 * np.sum(np.cross(R, Rd, axis=-2), axis=-1)
 
-    def points(self, q, X) -> np.ndarray:
+    def points(self, q: ArrayLike, X: ArrayLike) -> np.ndarray:
         """Positions of the body-fixed points ``X`` (n_points, dim) in the states ``q``: (..., n_points, dim).
 
         Also the velocities of the points when ``q`` holds velocities (the map is linear).
@@ -284,7 +288,7 @@ class RigidBody:
         x = q[..., None, :self.dim]
         return x + np.einsum("pk,...kd->...pd", X, np.swapaxes(self.orientation(q), -1, -2))
 
-    def centre_of_mass(self, q) -> np.ndarray:
+    def centre_of_mass(self, q: ArrayLike) -> np.ndarray:
         """Position of the centre of mass in the states ``q``: (dim,) or (n, dim)."""
         return self.points(q, self.com[None, :])[..., 0, :]
 
