@@ -82,8 +82,9 @@ def bodies_of(result: Result, beam: Beam | RigidBody | None = None) -> list[tupl
     result : Result
     beam : Beam or RigidBody, optional
         Given: that one body owns all coordinates. Otherwise the bodies are rebuilt from the description
-        in ``result.model``: one body's (a Beam's or a RigidBody's), or a system's ``"bodies"`` list,
-        whose coordinates are stacked in its order.
+        in ``result.model``: one body's (a Beam's or a RigidBody's), or a system's ``"bodies"`` list
+        (under ``"system"``, with the first coordinate of each body in ``"offsets"``; without offsets
+        the coordinates are stacked in the list's order).
 
     Returns
     -------
@@ -97,10 +98,13 @@ def bodies_of(result: Result, beam: Beam | RigidBody | None = None) -> list[tupl
     if beam is not None:
         return [(beam, slice(None))]
     model = result.model or {}
-    if "bodies" in model:
+    system = model.get("system", model)
+    if "bodies" in system:
         parts, start = [], 0
-        for k, record in enumerate(model["bodies"]):
+        offsets = system.get("offsets") or []
+        for k, record in enumerate(system["bodies"]):
             body = _body_from_description(record, f"result.model['bodies'][{k}]")
+            start = int(offsets[k]) if k < len(offsets) else start
             parts.append((body, slice(start, start + body.n_dof)))
             start += body.n_dof
         if start != result.q.shape[1]:

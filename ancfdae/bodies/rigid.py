@@ -90,6 +90,9 @@ class RigidBody:
 
     mass_is_constant = True
     potential_degree = 1
+    #: The orthonormality rows do not depend on time and are quadratic in ``q`` (read by a System).
+    rheonomic = False
+    constraint_degree = 2
 
     def __init__(self, mass: float, inertia: float | ArrayLike, position: ArrayLike,
                  orientation: float | ArrayLike | None = None, *, com: ArrayLike | None = None,
@@ -240,6 +243,11 @@ class RigidBody:
         """``(g_t, gamma)`` of ``G v + g_t = 0``, ``G a = gamma``."""
         self._check(q, v)
         return self._ortho.constraint_rates(t, q, v)
+
+    def constraint_velocity_jacobian(self, t: float, q: np.ndarray, v: np.ndarray) -> sp.csr_matrix:
+        """``Z(v) = d(G v)/dq`` on G's pattern (index-2 formulations): ``G`` is linear in ``q``, so ``Z(v) = G(v)``."""
+        self._check(q, v)
+        return self._ortho.constraint_jacobian(t, v)
 
     # -- where joints take hold -----------------------------------------------------
     def attachment(self, where: ArrayLike | None = None) -> Attachment:

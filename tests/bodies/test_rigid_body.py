@@ -100,6 +100,9 @@ def test_constraint_derivatives_against_finite_differences(dim):
     # The pattern is fixed: the same indices at any state.
     G2 = body.constraint_jacobian(0.0, RNG.standard_normal(n))
     assert np.array_equal(G.indices, G2.indices) and np.array_equal(G.indptr, G2.indptr)
+    Z = body.constraint_velocity_jacobian(0.0, q, v)
+    assert rel_err(Z.toarray(), fd_gradient(lambda x: body.constraint_jacobian(0.0, x) @ v, q)) < 1e-9
+    assert np.array_equal(Z.indices, G.indices)
     g_t, gamma = body.constraint_rates(0.0, q, v)
     e = 1e-3   # g is quadratic: the central second difference along v is exact up to rounding
     second = (body.constraints(0.0, q + e * v) - 2 * body.constraints(0.0, q) + body.constraints(0.0, q - e * v)) / e**2

@@ -67,8 +67,8 @@ def test_vtk_of_a_system_writes_one_part_per_body(tmp_path):
     q = np.concatenate([qb, qr])[None].repeat(2, 0)
     v = np.concatenate([vb, vr])[None].repeat(2, 0)
     q[1, beam.n_dof:beam.n_dof + 2] += [0.1, 0.2]              # move the body only
-    res = Result(t=np.array([0.0, 1.0]), q=q, v=v, a=0 * q,
-                 model={"bodies": [describe_model(beam), describe_model(body)]})
+    res = Result(t=np.array([0.0, 1.0]), q=q, v=v, a=0 * q,       # as a System describes itself
+                 model={"system": {"bodies": [beam.describe(), body.describe()], "offsets": [0, beam.n_dof]}})
     pvd = vtk(res, directory=tmp_path, name="sys")
     entries = ET.parse(pvd).getroot().findall("./Collection/DataSet")
     assert [(e.get("part"), e.get("file")) for e in entries[:2]] == [("0", "sys_0_000000.vtu"), ("1", "sys_1_000000.vtu")]
