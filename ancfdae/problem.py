@@ -152,12 +152,11 @@ class Model(Protocol):
 #:     ``symmetry_generators``, ``potential_degree``), see :class:`PotentialModel`
 #:     (energy-momentum integrators).
 #: ``"constraints"``
-#:     holonomic constraints ``g(t, q) = 0`` (``n_constraints`` rows); the equations of motion are
-#:     ``r(t, q, v, a) + G^T lambda = 0``, ``g = 0`` (``residual`` stays without ``G^T lambda``):
-#:     ``constraints(t, q) -> g``, ``constraint_jacobian(t, q) -> G = dg/dq`` (CSR, fixed pattern),
-#:     ``constraint_force_jacobian(t, q, lam) -> d(G^T lam)/dq`` (CSR), ``constraint_rates(t, q, v) ->
-#:     (g_t, gamma)`` with the velocity constraint ``G v + g_t = 0`` and the acceleration constraint
-#:     ``G a = gamma``, ``gamma = -(Z(v) v + 2 G_t v + g_tt)``, ``Z(v) = d(G v)/dq``.
+#:     holonomic constraints ``g(t, q) = 0`` (joints, prescribed motions): ``n_constraints``,
+#:     ``constraints``, ``constraint_jacobian``, ``constraint_force_jacobian``, ``constraint_rates``, see
+#:     :class:`ConstrainedModel`. The equations of motion become ``r(t, q, v, a) + G^T lam = 0``,
+#:     ``g(t, q) = 0``; ``residual`` stays without the ``G^T lam`` term (the integrator adds it), and only
+#:     a stepper that declares ``handles_constraints = True`` is run on such a model.
 CAPABILITIES: dict[str, tuple[str, ...]] = {
     "residual_jacobian": ("residual_jacobian",),
     "residual_stages": ("residual_stages",),
