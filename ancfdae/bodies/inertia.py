@@ -27,7 +27,8 @@ __all__ = ["euler_matrix", "inertia_tensor", "equivalent_box"]
 
 def inertia_tensor(inertia, dim: int) -> np.ndarray:
     """The inertia argument of a rigid body checked: a float (2D, ``I_zz``), or 3 principal moments or a
-    symmetric positive definite 3x3 tensor (3D) that satisfies the triangle inequalities of a real body.
+    symmetric positive definite 3x3 tensor (3D) that satisfies the triangle inequalities of a real body
+    (equality: a lamina such as a thin disk).
 
     Returns
     -------
@@ -53,11 +54,12 @@ def inertia_tensor(inertia, dim: int) -> np.ndarray:
     if not np.allclose(arr, arr.T, rtol=1e-12, atol=0.0):
         raise ValueError(f"`inertia` must be symmetric, got {arr.tolist()}.")
     principal = np.linalg.eigvalsh(arr)
-    # J_c = tr/2 I - Theta must be positive definite: every principal moment below the sum of the others.
-    if principal[0] <= 0 or principal[2] >= principal[0] + principal[1]:
-        raise ValueError(f"`inertia` must be the tensor of a real body: positive principal moments, each "
-                         f"smaller than the sum of the other two (strictly); got principal moments "
-                         f"{principal.tolist()}.")
+    # J_c = tr/2 I - Theta must be positive semi-definite: no principal moment above the sum of the others.
+    # Equality is a lamina (a thin disk: m r^2/2 = 2 m r^2/4): M is then singular along the director normal
+    # to it, but positive on the rigid motions, so the constrained equations stay regular.
+    if principal[0] <= 0 or principal[2] > (principal[0] + principal[1]) * (1 + 1e-12):
+        raise ValueError(f"`inertia` must be the tensor of a real body: positive principal moments, none "
+                         f"larger than the sum of the other two; got principal moments {principal.tolist()}.")
     return arr
 
 
@@ -95,4 +97,4 @@ def equivalent_box(mass: float, inertia: np.ndarray) -> tuple[np.ndarray, np.nda
         return np.array([half, half]), np.eye(2)
     Jc = 0.5 * np.trace(inertia) * np.eye(3) - inertia
     lam, axes = np.linalg.eigh(Jc)
-    return 0.5 * np.sqrt(12.0 * lam / mass), axes
+    return 0.5 * np.sqrt(12.0 * np.maximum(lam, 0.0) / mass), axes

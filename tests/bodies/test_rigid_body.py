@@ -194,7 +194,7 @@ def test_model_contract_capabilities_and_description():
 
 
 @pytest.mark.parametrize("kwargs, match", [
-    (dict(mass=1.0, inertia=[1.0, 1.0, 2.5], position=[0, 0, 0]), "sum of the other two"),
+    (dict(mass=1.0, inertia=[1.0, 1.0, 2.0 + 1e-9], position=[0, 0, 0]), "sum of the other two"),
     (dict(mass=1.0, inertia=[[1, 0.1, 0], [0, 1, 0], [0, 0, 1]], position=[0, 0, 0]), "symmetric"),
     (dict(mass=-1.0, inertia=1.0, position=[0, 0]), "`mass`"),
     (dict(mass=1.0, inertia=0.0, position=[0, 0]), "`inertia`"),
@@ -212,6 +212,15 @@ def test_model_contract_capabilities_and_description():
 def test_bad_input_names_the_argument(kwargs, match):
     with pytest.raises(ValueError, match=match):
         RigidBody(**kwargs)
+
+
+def test_a_thin_disk_is_a_body_whose_mass_is_regular_on_rigid_motions():
+    # Catches: a lamina (I_axial = I_1 + I_2) rejected, or its kinetic energy wrong on rigid motions.
+    m, r = 1.0, 0.1
+    disk = RigidBody(m, [m * r * r / 4, m * r * r / 4, m * r * r / 2], [0, 0, 0], angular_velocity=[1.0, 2.0, 3.0])
+    q, v = disk.initial_state()
+    assert disk.energy(0.0, q, v).kinetic == pytest.approx(0.5 * m * r * r * (1 / 4 + 4 / 4 + 9 / 2), rel=1e-14)
+    assert np.linalg.matrix_rank(disk.mass().toarray()) == 9      # d3 carries no mass: a lamina
 
 
 def test_wrong_state_length_is_a_clear_error():
