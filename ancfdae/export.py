@@ -80,8 +80,9 @@ def bodies_of(result: Result, beam: Beam | RigidBody | None = None) -> list[tupl
     Parameters
     ----------
     result : Result
-    beam : Beam or RigidBody, optional
-        Given: that one body owns all coordinates. Otherwise the bodies are rebuilt from the description
+    beam : Beam, RigidBody or System, optional
+        Given: that one body owns all coordinates (a System: its bodies at their ``offsets``). Otherwise the
+        bodies are rebuilt from the description
         in ``result.model``: one body's (a Beam's or a RigidBody's), or a system's ``"bodies"`` list
         (under ``"system"``, with the first coordinate of each body in ``"offsets"``; without offsets
         the coordinates are stacked in the list's order).
@@ -95,6 +96,8 @@ def bodies_of(result: Result, beam: Beam | RigidBody | None = None) -> list[tupl
     ValueError
         When the description names no body, or its bodies' coordinates do not add up to the result's.
     """
+    if beam is not None and hasattr(beam, "bodies") and hasattr(beam, "offsets"):      # a System
+        return [(b, slice(int(o), int(o) + b.n_dof)) for b, o in zip(beam.bodies, beam.offsets)]
     if beam is not None:
         return [(beam, slice(None))]
     model = result.model or {}
@@ -180,8 +183,8 @@ def vtk(result: Result, beam: Beam | RigidBody | None = None, directory: str | o
     ----------
     result : Result
         Output of :func:`ancfdae.simulate` (or :meth:`Result.load`).
-    beam : Beam or RigidBody, optional
-        The body of the run; default: rebuilt from ``result.model`` (a beam's or a rigid body's
+    beam : Beam, RigidBody or System, optional
+        The body (or system) of the run; default: rebuilt from ``result.model`` (a beam's or a rigid body's
         description, or a system's list ``"bodies"`` whose coordinates are stacked in its order).
     directory : str or path-like
         Created if missing; receives ``NAME.pvd`` and ``NAME_000000.vtu``, ... (a system:

@@ -1,6 +1,7 @@
 """Rigid bodies in the ParaView series, ancfdae.plot and the CLI: the box of their inertia, rebuilt from the
 result file alone."""
 import xml.etree.ElementTree as ET
+from types import SimpleNamespace
 
 import matplotlib
 import meshio
@@ -77,6 +78,11 @@ def test_vtk_of_a_system_writes_one_part_per_body(tmp_path):
     assert np.abs(last_beam.point_data["displacement"]).max() < 1e-15
     assert np.allclose(last_body.point_data["displacement"][:, :2], [0.1, 0.2], rtol=0, atol=1e-15)
     assert last_body.cells[0].type == "quad"
+    # The system object itself (bodies at their offsets) gives the same files.
+    system = SimpleNamespace(bodies=[beam, body], offsets=[0, beam.n_dof], n_dof=beam.n_dof + body.n_dof)
+    vtk(res, system, directory=tmp_path / "given", name="sys")
+    again = meshio.read(tmp_path / "given" / "sys_1_000001.vtu")
+    assert np.array_equal(again.points, last_body.points)
     res_bad = Result(t=res.t, q=q[:, :-1], v=v[:, :-1], a=0 * q[:, :-1], model=res.model)
     with pytest.raises(ValueError, match="coordinates"):
         vtk(res_bad, directory=tmp_path)
