@@ -10,10 +10,14 @@ included); :class:`RunInterrupted` carries the part of a run computed before a K
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ancfdae.integrators.protocol import StepOutcome
+
+if TYPE_CHECKING:
+    from ancfdae.result import Result
 
 __all__ = ["step_problem", "hooks_stop", "read_only", "RunInterrupted"]
 
@@ -37,7 +41,7 @@ class RunInterrupted(KeyboardInterrupt):
         Every output up to the interruption; ``status`` "failed", ``t_fail`` the last time reached.
     """
 
-    def __init__(self, message: str, result) -> None:
+    def __init__(self, message: str, result: Result) -> None:
         super().__init__(message)
         self.result = result
 
