@@ -152,7 +152,8 @@ class Model(Protocol):
 #:     nothing changed. The driver carries the state, restarts the integrator when it changes and
 #:     stores it in ``Result.model_state``.
 #: ``"potential"``
-#:     the residual splits as ``M a + dP/dq - f_nc(t, q)`` with a constant ``M``:
+#:     the residual splits as ``M a + dP/dq - f_nc(t, q)`` with a constant ``M`` (with
+#:     ``"mass_forms"``: ``d/dt(M(q) v) - dT/dq + dP/dq - f_nc``):
 #:     ``potential``, ``potential_gradient``, ``nonconservative_force`` (and optionally
 #:     ``symmetry_generators``, ``potential_degree``), see :class:`PotentialModel`
 #:     (energy-momentum integrators).
