@@ -219,8 +219,8 @@ def factorize(matrix):
     non-finite correction); SuperLU raises RuntimeError for an exactly
     singular matrix.
     """
-    if isinstance(matrix, StageMatrix):
-        return matrix.factorize()
+    if isinstance(matrix, StageMatrix) or (not sp.issparse(matrix) and callable(getattr(matrix, "factorize", None))):
+        return matrix.factorize()   # a matrix object that factorises itself (StageMatrix, GGL's ReducedMatrix)
     if not sp.issparse(matrix):
         arr = np.asarray(matrix)
         if not np.iscomplexobj(arr):

@@ -27,7 +27,9 @@ import scipy.sparse as sp
 from numpy.typing import ArrayLike
 
 from ancfdae import _validate as validate
+from ancfdae.integrators._constraint_terms import consistent_multipliers, constraint_rows
 from ancfdae.integrators._ida_jacobian import _JacobianFiller
+from ancfdae.integrators.ida_constrained import GGLResidual
 from ancfdae.integrators.integrator import Integrator
 from ancfdae.integrators.protocol import StepOutcome
 from ancfdae.problem import Model
@@ -122,6 +124,7 @@ class IDA(Integrator):
     order = None
     fixed_step = False
     consistent_restart = True
+    handles_constraints = True
 
     def __init__(self, model: Model, rtol: float = 1e-6, atol: float | ArrayLike | None = None, *,
                  max_order: int = 5, max_step: float = 0.0, first_step: float = 0.0,
@@ -143,6 +146,7 @@ class IDA(Integrator):
         self.linsolver = validate.choice("linsolver", linsolver, ("auto", "band", "sparse", "dense"))
         self._ls = self.linsolver if self.linsolver != "auto" else ("band" if 2 * self.n_dof <= 2000 else "sparse")
         self._solver = None
+        self._ggl = None           # the GGL form of a constrained model (set up by initialize)
         self._reinits = 0
 
     def options(self) -> dict:
@@ -192,11 +196,15 @@ class IDA(Integrator):
 
     def _split(self, y, yp):
         n = self.n_dof
+        if self._ggl is not None:
+            return self._ggl.split(y, yp)[:3]
         if self._perm is None:
             return y[:n].copy(), y[n:].copy(), yp[n:].copy()
         return y[0::2].copy(), y[1::2].copy(), yp[1::2].copy()
 
     def _join(self, q, v, a):
+        if self._ggl is not None:
+            return self._ggl.join(q, v, a, self.lam)
         y, yp = np.r_[q, v], np.r_[v, a]
         return (y, yp) if self._perm is None else (y[self._perm], yp[self._perm])
 
@@ -206,6 +214,10 @@ class IDA(Integrator):
         n, t0, q0, v0, a0 = self.n_dof, self.t, self.q, self.v, self.a
         self._reinits = 0
         self._replay = False
+        self._ggl = None
+        if constraint_rows(self.model):
+            self._setup_constrained()
+            return
         blocks0 = self.model.jacobian(t0, q0, v0, a0)
         self._filler = _JacobianFiller(blocks0, n)
         self._perm = None
@@ -235,6 +247,34 @@ class IDA(Integrator):
             self._solver = _sundae().ida.IDA(self._resfn, **opts)
         self._solver.init_step(t0, *self._join(q0, v0, a0))
 
+    def _setup_constrained(self) -> None:
+        """The GGL form (:mod:`ancfdae.integrators.ida_constrained`) with consistent ``(a0, lam0)``."""
+        if self.lam is None:     # no multipliers given: (a0, lam0) from the KKT system
+            self.a, self.lam = consistent_multipliers(self.model, self.t, self.q, self.v)
+        ls = self._ls
+        self._ggl = ggl = GGLResidual(self.model, self.t, self.q, self.v, self.a, self.lam, ls)
+        self._perm = None
+        opts = dict(rtol=self.rtol, max_order=self.max_order, jacfn=ggl.jacfn, max_step=self.max_step,
+                    first_step=self.first_step, linsolver=ls, max_num_steps=1_000_000,
+                    algebraic_idx=ggl.algebraic_idx)
+        if ls == "sparse":
+            opts.update(sparsity=ggl.pattern, nthreads=1)
+        elif ls == "band":
+            opts.update(lband=ggl.bandwidth, uband=ggl.bandwidth)
+        n = self.n_dof
+        if self.atol is None:
+            L = max(1.0, float(np.max(np.abs(self.q))))
+            atol_qv = np.r_[np.full(n, self.rtol * L), np.full(n, self.rtol * L / (self.t_bound - self.t))]
+        else:
+            arr = np.atleast_1d(np.asarray(self.atol, dtype=float))
+            atol_qv = arr[0] if arr.size == 1 else (np.r_[np.full(n, arr[0]), np.full(n, arr[1])] if arr.size == 2
+                                                    else arr)
+        opts["atol"] = ggl.atol(atol_qv)
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message="Custom sparse Jacobian")
+            self._solver = _sundae().ida.IDA(ggl.resfn, **opts)
+        self._solver.init_step(self.t, *self._join(self.q, self.v, self.a))
+
     def step(self) -> StepOutcome:
         """One internal IDA step towards the end of the run (IDA's state advances with it)."""
         while True:
@@ -255,6 +295,9 @@ class IDA(Integrator):
         y, yp = np.asarray(out.y).reshape(-1), np.asarray(out.yp).reshape(-1)
         if not (np.isfinite(y).all() and np.isfinite(yp).all()):
             return StepOutcome.failure("the solution became non-finite")
+        if self._ggl is not None:
+            q, v, a, lam = self._ggl.split(y, yp)
+            return StepOutcome(ok=True, t=t_new, q=q, v=v, a=a, lam=lam)
         q, v, a = self._split(y, yp)
         return StepOutcome(ok=True, t=t_new, q=q, v=v, a=a)
 
@@ -278,6 +321,9 @@ class IDA(Integrator):
             As for :meth:`~ancfdae.integrators.Integrator.restart` (``a`` consistent: ``consistent_restart``).
         """
         super().restart(t, q, v, a, model)
+        if self._ggl is not None:    # multipliers consistent with the changed state (and a with them)
+            self.a, self.lam = consistent_multipliers(self.model, self.t, q, v)
+            a = self.a
         self._solver.init_step(float(t), *self._join(q, v, a))
         self._replay = False
         self._reinits += 1

@@ -61,12 +61,17 @@ class Integrator(ABC):
         Start and end of the run.
     n_steps : int
         Steps accepted since :meth:`initialize`.
+    lam : ndarray or None
+        The current multipliers of a constrained model (from ``initialize(..., lam0=...)``, then each
+        accepted ``StepOutcome.lam``); None otherwise.
     """
 
     name: str = "integrator"
     order: int | None = None
     fixed_step: bool = True
     consistent_restart: bool = False
+    #: True for a stepper that integrates models with the ``"constraints"`` capability
+    handles_constraints: bool = False
 
     def __init__(self, model: Model, h: float | None = None) -> None:
         self.n_dof = check_model(model)
@@ -78,7 +83,7 @@ class Integrator(ABC):
 
     # -- the protocol ---------------------------------------------------------------------------
     def initialize(self, model: Model, t0: float, q0: np.ndarray, v0: np.ndarray, a0: np.ndarray,
-                   t_bound: float, *, want_quadrature: bool = False) -> None:
+                   t_bound: float, *, want_quadrature: bool = False, lam0: np.ndarray | None = None) -> None:
         """Take the model of the run, the initial state and the end of the run; no step is taken.
 
         Parameters
@@ -93,11 +98,16 @@ class Integrator(ABC):
             End of the run.
         want_quadrature : bool
             True when monitors will use each step's quadrature.
+        lam0 : array_like, shape (n_constraints,), optional
+            The consistent initial multipliers of a model with the ``"constraints"`` capability
+            (with ``a0`` from the same KKT system); None: a stepper that handles constraints
+            computes both itself.
         """
         self.model.rebind(model)
         self.want_quadrature = bool(want_quadrature)
         self.t = float(t0)
         self.q, self.v, self.a = (np.array(x, dtype=float) for x in (q0, v0, a0))
+        self.lam = None if lam0 is None else np.array(lam0, dtype=float)
         self.t0, self.t_bound = self.t, float(t_bound)
         self.previous = None
         self.n_steps = 0
@@ -127,6 +137,8 @@ class Integrator(ABC):
         """
         self.previous = (self.t, self.q, self.v, self.a)
         self.t, self.q, self.v, self.a = outcome.t, outcome.q, outcome.v, outcome.a
+        if outcome.lam is not None:
+            self.lam = outcome.lam
         self.n_steps += 1
 
     def interpolate(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

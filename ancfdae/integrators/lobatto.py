@@ -39,7 +39,9 @@ import scipy.sparse as sp
 from ancfdae import _validate as validate
 from ancfdae.integrators._affine import affine2, stage_constants, stage_states
 from ancfdae.integrators._linsolve import StageMatrix
+from ancfdae.integrators._constraint_terms import consistent_multipliers, constraint_rows
 from ancfdae.integrators._newton_records import NewtonOptions
+from ancfdae.integrators.lobatto_constrained import GGLStages, ggl_step
 from ancfdae.integrators.newton_stepper import NewtonStepper
 from ancfdae.integrators.protocol import Quadrature, StepOutcome
 from ancfdae.problem import Model, capabilities
@@ -156,6 +158,8 @@ class LobattoIIIA(NewtonStepper):
         instead of 4.7 iterations per step.
     """
 
+    handles_constraints = True
+
     def __init__(self, model: Model, h: float, stages: int | ButcherTableau = 3, *,
                  newton: NewtonOptions | dict | None = None, predictor: str = "constant") -> None:
         super().__init__(model, h, newton=newton)
@@ -197,6 +201,11 @@ class LobattoIIIA(NewtonStepper):
         self._prev = None  # (h, stage accelerations (n, s)) of the last step
         self._w_cache = None
         self._stages = "residual_stages" in capabilities(self.model)   # declared, forwarded by the proxy
+        self._ggl = None
+        if constraint_rows(self.model):   # constrained: the GGL stage system (lobatto_constrained)
+            if self.lam is None:          # no multipliers given: (a0, lam0) from the KKT system
+                self.a, self.lam = consistent_multipliers(self.model, self.t, self.q, self.v)
+            self._ggl = GGLStages(self)
 
     # -- predictor -------------------------------------------------------------------------
     def _guess(self, h):
@@ -256,6 +265,8 @@ class LobattoIIIA(NewtonStepper):
 
     # -- one step ----------------------------------------------------------------------------
     def _step_impl(self, t, h):
+        if self._ggl is not None:
+            return ggl_step(self, self._ggl, t, h)
         m, n, model = self._m, self.n_dof, self.model
         ts = t + self._c * h
         # Stage states are affine in X: V = V0 + X @ CV, Q = Q0 + X @ CQ (constant parts once per step).
