@@ -27,7 +27,7 @@ class SymplecticEuler(FixedStepIntegrator):
 
 
 class _NaNAfterPotential(NaNAfter):
-    """The same, declaring the "potential" capability that the energy-momentum stepper needs."""
+    """The same, declaring the "potential" capability that the energy-conserving steppers need."""
 
     capabilities = frozenset({"potential"})
 
@@ -35,7 +35,7 @@ class _NaNAfterPotential(NaNAfter):
 ALL = [(m, {"rtol": 1e-7} if m == "ida" else {"h": 0.01}) for m in METHODS] + [(SymplecticEuler, {"h": 1e-3})]
 #: methods that need a constant mass matrix and the "potential" capability run on the spring chain
 #: (the double pendulum's mass depends on q)
-NEEDS_POTENTIAL = {"energy-momentum"}
+NEEDS_POTENTIAL = {"energy-momentum", "energy-collocation"}
 IDS = [m if isinstance(m, str) else m.name for m, _ in ALL]
 
 
