@@ -246,7 +246,7 @@ class EnergyCollocation(NewtonStepper):
                 out = term if out is None else out + term
         return out.tocsr()
 
-    def stage_equations(self, t0: float, h: float, split: list):
+    def stage_equations(self, t0: float, h: float, split: list) -> tuple:
         """The step's equations from the current state: ``(residual(x), jacobian(x))`` of the unknowns
         ``x = Y.ravel()`` (interleaved); ``jacobian`` returns ``(matrix, floor)``, the split matrix while
         ``split[0]`` is true, else the exact Jacobian."""
