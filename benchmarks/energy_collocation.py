@@ -165,6 +165,9 @@ def long_runs(a):
              ("SQ3D", {}), ("SQ3D", {"formulation": "continuum"})]
     h = 1e-2
     for name, kw in cases:
+        label = name + ("-" + kw["formulation"] if kw else "")
+        if a.cases and label not in a.cases:
+            continue
         el = getattr(models, name)(mat, sec, **kw)
         if name.endswith("2D"):
             t_load, f = 0.3, pulse(0.3)
@@ -201,6 +204,7 @@ def main(argv=None):
     ap.add_argument("--k", type=int, nargs="+", default=[4, 5, 6])
     ap.add_argument("--steps", type=int, default=10_000)
     ap.add_argument("--elements", type=int, default=1)
+    ap.add_argument("--cases", nargs="+", default=None, help="long: only these (e.g. SQ3D SQ3D-continuum)")
     ap.add_argument("--h-ref", type=float, default=None, help="step of the reference run (default: a quarter of the finest)")
     ap.add_argument("--out", type=Path, default=Path("out/energy_collocation"))
     a = ap.parse_args(argv)

@@ -33,6 +33,9 @@ What holds
 * Linear momentum ``T^T M v``: exact (the rule sums internal forces orthogonal to the translations).
   Angular momentum: not exact (the forces are evaluated off the configuration a rotation invariant
   needs); it drifts at the truncation error's size (``docs/energy_momentum.md``).
+* Constrained models (capability ``"constraints"``, rows at most quadratic in ``q``): a multiplier
+  polynomial of degree 1 and two conditions per row keep ``g(t1, q1) = 0`` and the energy
+  (:mod:`ancfdae.integrators._hbvm_constrained`).
 
 Newton
 ------
@@ -54,14 +57,16 @@ import scipy.sparse.linalg as spla
 
 from ancfdae import _validate as validate
 from ancfdae._scale import ENERGY_ROUNDOFF
+from ancfdae.integrators._alpha_index3 import mass_scale
 from ancfdae.integrators._hbvm_coefficients import hbvm_coefficients
+from ancfdae.integrators._hbvm_constrained import constrained_hbvm_step
 from ancfdae.integrators._linsolve import StageMatrix
 from ancfdae.integrators._newton_records import NewtonOptions
 from ancfdae.integrators._potential_split import require_potential_model, require_potential_split
 from ancfdae.integrators.energy_momentum import DEFAULT_NEWTON
 from ancfdae.integrators.newton_stepper import NewtonStepper
 from ancfdae.integrators.protocol import Quadrature, StepOutcome
-from ancfdae.problem import JacobianBlocks, Model
+from ancfdae.problem import JacobianBlocks, Model, capabilities
 
 __all__ = ["EnergyCollocation", "SMOOTH_SILENT_STAGES", "ITERATION_MATRICES"]
 
@@ -134,12 +139,17 @@ class EnergyCollocation(NewtonStepper):
     name = "energy-collocation"
     order = 4
     fixed_step = True
+    handles_constraints = True
     FLOOR_ROUNDOFF = ENERGY_ROUNDOFF
     FLOOR_UPDATE = "replace"     # as energy-momentum: the energy identity needs the latest floor
 
     def __init__(self, model: Model, h: float, *, silent_stages: int | str = "auto",
                  iteration_matrix: str = "split", newton: NewtonOptions | dict | None = None) -> None:
         require_potential_model(model, self.name)
+        if "constraints" in capabilities(model) and getattr(model, "constraint_degree", None) not in (1, 2):
+            raise ValueError("`model` constraints must be at most quadratic in q (constraint_degree 1 or 2) for "
+                             f"method {self.name!r}, whose 3-point exactness of d g(sigma)/dc keeps the joints "
+                             f"workless; got constraint_degree={getattr(model, 'constraint_degree', None)!r}.")
         super().__init__(model, h, newton=DEFAULT_NEWTON if newton is None else newton)
         degree = getattr(model, "potential_degree", None)
         if isinstance(silent_stages, str) and silent_stages == "auto":
@@ -166,6 +176,11 @@ class EnergyCollocation(NewtonStepper):
         super()._setup()
         self._bind()
         require_potential_split(self.model, self.t, self.q, self.v, self.name)
+        self._constrained = "constraints" in capabilities(self.model)
+        if self._constrained:
+            self._mscale = mass_scale(self._M)
+            if self.lam is None:
+                self.lam = np.zeros(self.model.n_constraints)
 
     def _bind(self):
         m = self.model
@@ -231,7 +246,7 @@ class EnergyCollocation(NewtonStepper):
                 out = term if out is None else out + term
         return out.tocsr()
 
-    def stage_equations(self, t0: float, h: float, split: list):
+    def stage_equations(self, t0: float, h: float, split: list) -> tuple:
         """The step's equations from the current state: ``(residual(x), jacobian(x))`` of the unknowns
         ``x = Y.ravel()`` (interleaved); ``jacobian`` returns ``(matrix, floor)``, the split matrix while
         ``split[0]`` is true, else the exact Jacobian."""
@@ -260,6 +275,8 @@ class EnergyCollocation(NewtonStepper):
 
     def _step_impl(self, t0, h):
         """One HBVM(k, 2) step from the current state; the state is left unchanged."""
+        if self._constrained:
+            return constrained_hbvm_step(self, t0, h)
         co, n, model = self._co, self.n_dof, self.model
         q0, v0 = self.q, self.v
         split = [self.iteration_matrix == "split" and self.newton.options.jacobian == "modified"]

@@ -27,7 +27,7 @@ class SymplecticEuler(FixedStepIntegrator):
 
 
 class _NaNAfterPotential(NaNAfter):
-    """The same, declaring the "potential" capability that the energy-momentum stepper needs."""
+    """The same, declaring the "potential" capability that the energy-conserving steppers need."""
 
     capabilities = frozenset({"potential"})
 
