@@ -14,7 +14,9 @@ from .problem import Energy, JacobianBlocks, Model
 from .static import StaticResult, solve_static
 from .simulate import METHODS, simulate
 from .result import Result, ResultFileError
-from .monitors import EnergyMonitor, PointSensor, Probe
+from .monitors import ConstraintMonitor, EnergyMonitor, PointSensor, Probe
+from .system import System
+from . import joints
 
 __version__ = "0.1.0"
 
@@ -28,4 +30,5 @@ __all__ = [
     "Model", "JacobianBlocks", "Energy",
     "solve_static", "StaticResult",
     "simulate", "METHODS", "Result", "ResultFileError", "EnergyMonitor", "PointSensor", "Probe",
+    "System", "joints", "ConstraintMonitor",
 ]

@@ -46,7 +46,7 @@ ENGINE = "netcdf4"
 #: (the attributes of :class:`ancfdae.Result`, which this module does not import: it reads and
 #: writes fields, and ``Result.load`` builds the object).
 FIELDS = ("t", "q", "v", "a", "status", "message", "stats", "monitors", "t_fail", "method", "options",
-          "model_state", "model")
+          "model_state", "model", "lam")
 _SUFFIXES = (".nc", ".nc4", ".h5")
 _UNITS = ("The model's consistent unit system (the studies use SI: m, s, kg); coordinate units per `dof`: "
           "positions length, slope coordinates 1, theta rad.")
@@ -135,6 +135,9 @@ def to_dataset(fields):
     n_t = fields["t"].size
     node, coord = _dof_labels(fields)
     data = {name: (("time", "dof"), fields[name]) for name in ("q", "v", "a")}
+    lam = fields.get("lam")
+    if lam is not None and lam.shape[1] > 0:    # a constrained model's multipliers
+        data["lam"] = (("time", "constraint"), lam, {"long_name": "multipliers (reactions -G^T lam)"})
     scalars: dict = {}
     for name, log in fields["monitors"].items():
         scalars[name] = {}
@@ -252,7 +255,8 @@ def from_dataset(ds, path="<dataset>") -> dict:
     return dict(t=t, q=arrays["q"], v=arrays["v"], a=arrays["a"], status=str(ds.attrs.get("status")),
                 message=str(ds.attrs.get("message", "")), stats=_loads(ds, "stats", path), monitors=monitors,
                 t_fail=None if math.isnan(t_fail) else t_fail, method=str(ds.attrs.get("method", "")),
-                options=_loads(ds, "options", path), model_state=state, model=model)
+                options=_loads(ds, "options", path), model_state=state, model=model,
+                lam=ds["lam"].values if "lam" in ds.variables else None)
 
 
 def read(path) -> dict:

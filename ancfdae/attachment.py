@@ -9,8 +9,9 @@ its Jacobian is affine in ``q`` and the derivative of ``G^T lambda`` does not de
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
+import numpy as np
 import scipy.sparse as sp
 
 __all__ = ["Attachment"]
@@ -18,23 +19,40 @@ __all__ = ["Attachment"]
 
 @dataclass(frozen=True)
 class Attachment:
-    """A material point of one body and its frame vectors, as constant linear maps of the body's coordinates.
+    """A material point of one body and its frame vectors, as constant affine maps of the body's coordinates.
 
     Attributes
     ----------
     position : scipy.sparse.csr_matrix, shape (dim, n_dof)
-        ``P`` with ``r = P q``: the point's position from the body's coordinates ``q``.
+        ``P`` with ``r = P q + offset``: the point's position from the body's coordinates ``q``.
     axes : tuple of scipy.sparse.csr_matrix, each shape (dim, n_dof)
-        ``D_k`` with ``d_k = D_k q``: the frame vectors at the point, in the body's own convention (a beam
+        ``D_k`` with ``d_k = D_k q + axes_offset[k]``: the frame vectors at the point, in the body's own convention (a beam
         node: its slope vectors, e.g. ``r_x`` for BE2D and Cable3D, ``r_x, r_y (, r_z)`` for SQ2D/SQ3D;
         a rigid body: its directors). Not normalised: a beam's slope stretches.
     label : str
         How the point was named (``"node 3"``, ``"s = 0.5"``, ``"point (0.1, 0, 0)"``) for messages.
+    offset : ndarray, shape (dim,), optional
+        The constant part of the position: coordinates a body eliminated (a beam's supports) are not
+        among ``q`` and enter here with their fixed values. Default zeros.
+    axes_offset : tuple of ndarray, each shape (dim,), optional
+        The constant parts of the frame vectors, likewise. Default zeros.
     """
 
     position: sp.csr_matrix
     axes: tuple[sp.csr_matrix, ...]
     label: str
+    offset: np.ndarray | None = field(default=None)
+    axes_offset: tuple[np.ndarray, ...] | None = field(default=None)
+
+    def __post_init__(self) -> None:
+        dim = self.position.shape[0]
+        if self.offset is None:
+            object.__setattr__(self, "offset", np.zeros(dim))
+        if self.axes_offset is None:
+            object.__setattr__(self, "axes_offset", tuple(np.zeros(dim) for _ in self.axes))
+        if len(self.axes_offset) != len(self.axes):
+            raise ValueError(f"`axes_offset` must hold one vector per axis ({len(self.axes)}), "
+                             f"got {len(self.axes_offset)}.")
 
     @property
     def dim(self) -> int:

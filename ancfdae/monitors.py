@@ -28,8 +28,10 @@ from typing import Any, Callable
 import numpy as np
 
 from ancfdae import _validate as validate
+from ancfdae.constrained import constraint_power
+from ancfdae.problem import capabilities
 
-__all__ = ["Monitor", "EnergyMonitor", "PointSensor", "Probe"]
+__all__ = ["Monitor", "EnergyMonitor", "PointSensor", "Probe", "ConstraintMonitor"]
 
 
 class Monitor:
@@ -127,7 +129,10 @@ class EnergyMonitor(Monitor):
 
     Notes
     -----
-    Internal damping is not a load: a damped model loses ``E``.
+    Internal damping is not a load: a damped model loses ``E``. On a constrained model (capability
+    ``"constraints"``) ``W_ext`` includes the work of the forces that drive prescribed motions,
+    ``int lam . g_t dt`` with ``lam`` from the KKT system at the quadrature nodes
+    (:func:`ancfdae.constrained.constraint_power`); scleronomic joints do no work.
     """
 
     def __init__(self, name: str = "energy", blowup: float = 0.1, stop_on_blowup: bool = False) -> None:
@@ -143,21 +148,26 @@ class EnergyMonitor(Monitor):
                 raise TypeError(f"EnergyMonitor needs `model.{attr}(t, q, v)`; "
                                 f"{type(model).__name__} has none.")
         self.model = model
+        self._constrained = "constraints" in capabilities(model)
         self._rows: list[tuple] = []
         self._work = 0.0
         self._t_prev = self._t_cur = float(t)
         self._w_prev = self._w_cur = 0.0
-        self._p_cur = float(model.external_power(t, q, v))
+        self._p_cur = self._power(t, q, v)
         self._scale = 0.0
         self._e0 = None
         self._blow = None
 
+    def _power(self, t, q, v):
+        p = float(self.model.external_power(t, q, v))
+        return p + constraint_power(self.model, t, q, v) if self._constrained else p
+
     def advance(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, nodes: tuple | None = None) -> None:
-        p_end = float(self.model.external_power(t, q, v))
+        p_end = self._power(t, q, v)
         if nodes is None:
             dw = 0.5 * (t - self._t_cur) * (self._p_cur + p_end)
         else:
-            dw = sum(wj * float(self.model.external_power(tj, qj, vj)) for tj, qj, vj, wj in zip(*nodes))
+            dw = sum(wj * self._power(tj, qj, vj) for tj, qj, vj, wj in zip(*nodes))
         self._t_prev, self._w_prev = self._t_cur, self._w_cur
         self._t_cur, self._w_cur, self._p_cur = float(t), self._w_cur + dw, p_end
 
@@ -280,3 +290,54 @@ class Probe(Monitor):
 
     def log(self) -> dict:
         return {"value": np.array(self._rows)}
+
+
+class ConstraintMonitor(Monitor):
+    """Drift of the position and velocity constraints of a constrained model, at every output time.
+
+    Logs ``position`` = ``max|g(t, q)|`` and ``velocity`` = ``max|G v + g_t|`` at the output times, and
+    ``step_position``/``step_velocity``: their largest values over the steps that ended since the
+    previous output. Output times inside a step hold interpolated states (the integrator's interpolant
+    does not satisfy ``g = 0`` exactly); the step values measure the method itself. Scalars
+    ``max_position`` and ``max_velocity`` over the run (step ends and outputs).
+
+    Parameters
+    ----------
+    name : str
+        Key in ``Result.monitors``.
+    """
+
+    def __init__(self, name: str = "constraints") -> None:
+        self.name = str(name)
+
+    def start(self, model: Any, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> None:
+        if "constraints" not in capabilities(model):
+            raise TypeError(f"ConstraintMonitor needs a model with the 'constraints' capability; "
+                            f"{type(model).__name__} has none.")
+        self.model = model
+        self._rows: list[tuple] = []
+        self._step = self._drift(t, q, v)
+        self._max = self._step
+
+    def _drift(self, t, q, v):
+        g = self.model.constraints(t, q)
+        g_t, _ = self.model.constraint_rates(t, q, v)
+        gv = self.model.constraint_jacobian(t, q) @ v + g_t
+        return float(np.max(np.abs(g), initial=0.0)), float(np.max(np.abs(gv), initial=0.0))
+
+    def advance(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, nodes: tuple | None = None) -> None:
+        d = self._drift(t, q, v)
+        self._step = (max(self._step[0], d[0]), max(self._step[1], d[1]))
+
+    def sample(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> None:
+        d = self._drift(t, q, v)
+        self._rows.append(d + self._step)
+        self._max = (max(self._max[0], d[0], self._step[0]), max(self._max[1], d[1], self._step[1]))
+        self._step = (0.0, 0.0)
+
+    def log(self) -> dict:
+        rows = np.array(self._rows, dtype=float).reshape(-1, 4)
+        out = {k: rows[:, i].copy() for i, k in enumerate(("position", "velocity", "step_position",
+                                                            "step_velocity"))}
+        out.update(max_position=self._max[0], max_velocity=self._max[1])
+        return out

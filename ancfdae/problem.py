@@ -16,7 +16,8 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["Model", "JacobianBlocks", "Energy", "CAPABILITIES", "capabilities", "PotentialModel"]
+__all__ = ["Model", "JacobianBlocks", "Energy", "CAPABILITIES", "capabilities", "PotentialModel",
+           "ConstrainedModel"]
 
 
 @dataclass(frozen=True)
@@ -161,7 +162,8 @@ class Model(Protocol):
 #:     ``constraint_velocity_jacobian(t, q, v) -> d(G v + g_t)/dq`` (csr (m, n)), which the index-2
 #:     (stabilised) formulations put in their Newton matrices; without it they form ``d(G v)/dq``
 #:     from ``m`` calls of ``constraint_force_jacobian`` and leave out ``dg_t/dq`` (exact for
-#:     constraints that do not depend on time).
+#:     constraints that do not depend on time). Only a stepper that declares
+#:     ``handles_constraints = True`` is run on such a model (see :class:`ConstrainedModel`).
 CAPABILITIES: dict[str, tuple[str, ...]] = {
     "residual_jacobian": ("residual_jacobian",),
     "residual_stages": ("residual_stages",),
@@ -204,6 +206,11 @@ def capabilities(model: object) -> frozenset:
         if missing:
             raise TypeError(f"{type(model).__name__} declares the capability {cap!r} but lacks the "
                             f"callable(s) {missing}.")
+    if "constraints" in declared:
+        m = getattr(model, "n_constraints", None)
+        if isinstance(m, bool) or not isinstance(m, (int, np.integer)) or m < 0:
+            raise TypeError(f"{type(model).__name__} declares 'constraints' but `n_constraints` is {m!r}, "
+                            "not a non-negative integer.")
     if "variable_mass" in declared and getattr(model, "mass_is_constant", False):
         raise TypeError(f"{type(model).__name__} declares 'variable_mass' but mass_is_constant is True.")
     return declared
@@ -254,3 +261,43 @@ class PotentialModel(Protocol):
         """
         ...
 
+
+
+# -- optional capability: holonomic constraints ---------------------------------------------
+@runtime_checkable
+class ConstrainedModel(Protocol):
+    """Holonomic constraints ``g(t, q) = 0`` with multipliers ``lam``: the ``"constraints"`` capability.
+
+    The equations of motion are the index-3 DAE::
+
+        r(t, q, v, a) + G(t, q)^T lam = 0,      g(t, q) = 0,      G = dg/dq
+
+    (``residual`` stays ``r``, without the ``G^T lam`` term; ``-G^T lam`` are the reaction forces). Hidden
+    in them: the velocity constraint ``G v + g_t = 0`` and the acceleration constraint ``G a = gamma`` with
+    ``gamma = -(Z(v) v + 2 G_t v + g_tt)``, ``Z(v) = d(G v)/dq``. Every derivative is exact and, like the
+    residual's, checked against finite differences. The joints of :mod:`ancfdae.joints` are at most
+    quadratic in ``q``, so ``G`` is affine in ``q`` and ``d(G^T lam)/dq`` does not depend on ``q``.
+
+    Attributes
+    ----------
+    n_constraints : int
+        ``m``, the number of rows of ``g``.
+    """
+
+    n_constraints: int
+
+    def constraints(self, t: float, q: np.ndarray) -> np.ndarray:
+        """``g(t, q)``, shape ``(m,)``."""
+        ...
+
+    def constraint_jacobian(self, t: float, q: np.ndarray) -> sp.spmatrix:
+        """``G = dg/dq``, CSR of shape ``(m, n_dof)`` on a fixed sparsity pattern (the same at every t, q)."""
+        ...
+
+    def constraint_force_jacobian(self, t: float, q: np.ndarray, lam: np.ndarray) -> sp.spmatrix:
+        """``d(G^T lam)/dq``, shape ``(n_dof, n_dof)`` (Newton matrices add it to ``K``)."""
+        ...
+
+    def constraint_rates(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(g_t, gamma)``, each shape ``(m,)``: ``G v + g_t = 0`` and ``G a = gamma`` on the motion."""
+        ...

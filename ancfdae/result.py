@@ -57,6 +57,10 @@ class Result:
         JSON-able description of the model (``model.describe()`` when it has
         one, plus ``"dof_labels"``: ``{"node": [...], "coordinate": [...]}``);
         empty when the model does not describe itself.
+    lam : ndarray, shape (n_out, n_constraints)
+        A constrained model's multipliers at ``t`` (the reaction forces are ``-G^T lam``), recomputed
+        from ``(t, q, v)`` by the KKT system; shape ``(n_out, 0)`` for a model without constraints.
+        The rows' labels are ``model["system"]["constraint_labels"]`` for an :class:`ancfdae.System`.
     """
 
     t: np.ndarray
@@ -72,6 +76,7 @@ class Result:
     options: dict = field(default_factory=dict)
     model_state: dict = field(default_factory=dict)
     model: dict = field(default_factory=dict)
+    lam: np.ndarray | None = None
 
     def __post_init__(self):
         if self.status not in _STATUSES:
@@ -85,6 +90,10 @@ class Result:
             if arr.ndim != 2 or arr.shape[0] != n:
                 raise ValueError(f"`{name}` must have shape ({n}, n_dof) to match `t`, got {arr.shape}.")
             setattr(self, name, arr)
+        lam = np.zeros((n, 0)) if self.lam is None else np.asarray(self.lam, dtype=float)
+        if lam.ndim != 2 or lam.shape[0] != n:
+            raise ValueError(f"`lam` must have shape ({n}, n_constraints) to match `t`, got {lam.shape}.")
+        self.lam = lam
         state = {}
         for key, arr in dict(self.model_state or {}).items():
             arr = np.asarray(arr, dtype=float)

@@ -1,4 +1,4 @@
-"""Energy balance E = T + U + V - W_ext (design.md Sect. 6) under every integrator.
+"""Energy balance E = T + U + V - W_ext under every integrator.
 
 Toy: the spring chain of toy_models with a pulse force (W_ext != 0 while it acts).
 B2 (benchmarks.md): free BE2D beam in the plane, 4 elements, force and moment pulse for 2.5 s,

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ancfdae.constrained import multipliers
 from ancfdae.result import Result
 
 __all__ = ["Recorder"]
@@ -17,9 +18,12 @@ class Recorder:
         Passed to the monitors' ``start``.
     monitors : sequence of Monitor
         Objects with ``start/advance/sample/log`` (names unique).
+    constrained : bool
+        Record the multipliers at every output, recomputed from ``(t, q, v)`` by the KKT system
+        (:func:`ancfdae.constrained.multipliers`).
     """
 
-    def __init__(self, model, monitors=()):
+    def __init__(self, model, monitors=(), constrained=False):
         monitors = list(monitors or ())
         names = set()
         for m in monitors:
@@ -30,6 +34,7 @@ class Recorder:
             names.add(m.name)
         self.model, self.monitors = model, monitors
         self.t, self.q, self.v, self.a, self.state = [], [], [], [], []
+        self.constrained, self.lam = constrained, []
 
     def start(self, t, q, v, a):
         """Start every monitor at the initial state."""
@@ -50,12 +55,15 @@ class Recorder:
 
     def sample(self, t, q, v, a, state=None):
         """Record one output time; ``state`` is the model's event state valid at ``t``."""
+        if self.constrained:    # first: a failing KKT solve leaves the record consistent
+            self.lam.append(multipliers(self.model, float(t), np.asarray(q, float), np.asarray(v, float))[1])
         self.t.append(float(t))
         self.q.append(np.array(q, dtype=float))
         self.v.append(np.array(v, dtype=float))
         self.a.append(np.array(a, dtype=float))
         if state is not None:
             self.state.append(state)
+
         for m in self.monitors:
             m.sample(t, q, v, a)
 
@@ -72,5 +80,7 @@ class Recorder:
         def stack(rows):
             return np.array(rows) if rows else np.zeros((0, n_dof))
         model_state = {k: np.array([s[k] for s in self.state]) for k in state_keys} if self.state else {}
-        return Result(t=np.array(self.t), q=stack(self.q), v=stack(self.v), a=stack(self.a),
+        m = getattr(self.model, "n_constraints", 0) if self.constrained else 0
+        lam = np.array(self.lam).reshape(len(self.t), m) if self.constrained else None
+        return Result(t=np.array(self.t), q=stack(self.q), v=stack(self.v), a=stack(self.a), lam=lam,
                       monitors={m.name: m.log() for m in self.monitors}, model_state=model_state, **kw)

@@ -29,6 +29,7 @@ from numpy.typing import ArrayLike
 
 from ancfdae import _validate as validate
 from ancfdae._resultfile import describe_model
+from ancfdae.constrained import consistent_state
 from ancfdae.integrators._recorder import Recorder
 from ancfdae.integrators.protocol import Stepper
 from ancfdae.problem import Model, capabilities
@@ -123,6 +124,22 @@ def _initial_state(model, n, q0, v0, state0, events):
     return q0, v0, state
 
 
+def _constrained_start(stepper, model, caps, events, t0, q0, v0):
+    """For a constrained model: check the stepper, project ``(q0, v0)`` and solve ``(a0, lam0)``; else None."""
+    if "constraints" not in caps:
+        return None
+    name = getattr(stepper, "name", type(stepper).__name__)
+    if not getattr(stepper, "handles_constraints", False):
+        raise TypeError(f"method {name!r} cannot integrate constrained models ({type(model).__name__} declares "
+                        f"'constraints', {model.n_constraints} rows): its stepper does not declare "
+                        "handles_constraints = True. Use 'generalized-alpha', 'hht', 'newmark' or "
+                        "'energy-momentum', or eliminate the supports instead of joining them.")
+    if events:
+        raise ValueError(f"{type(model).__name__} has both constraints and an event state ('step_events'); "
+                         "the driver does not carry constraints across model events yet.")
+    return consistent_state(model, t0, q0, v0)
+
+
 def _check_max_steps(stepper, t0, tf, max_steps):
     if max_steps is None:
         max_steps = DEFAULT_MAX_STEPS
@@ -199,6 +216,16 @@ def integrate(stepper: Stepper, model: Model, t_span: tuple[float, float], t_eva
         Never raises once the run has started; see the module docstring. ``stats`` are the
         stepper's with the driver's ``model_events``, ``restarts``, ``wall_time`` and ``cpu_time``;
         ``model`` is ``model``'s description (``describe()`` and ``dof_labels()``, when it has them).
+
+    Notes
+    -----
+    A model with the ``"constraints"`` capability (:class:`ancfdae.problem.ConstrainedModel`) needs a
+    stepper with ``handles_constraints``. Its initial state is made consistent before the run
+    (:func:`ancfdae.constrained.consistent_state`: ``q0`` projected onto ``g = 0``, ``v0`` onto
+    ``G v + g_t = 0``, ``(a0, lam0)`` from the KKT system; the corrections are logged and stored as
+    ``stats["initial_correction_q"]``/``["initial_correction_v"]``, a ``q0`` far from the constraints
+    raises), and ``Result.lam`` holds the multipliers at the output times recomputed from ``(t, q, v)``
+    by the KKT system (:func:`ancfdae.constrained.multipliers`), whose accuracy is that of ``(q, v)``.
     """
     n = check_model(model)
     caps = capabilities(model)
@@ -211,7 +238,8 @@ def integrate(stepper: Stepper, model: Model, t_span: tuple[float, float], t_eva
     max_steps = _check_max_steps(stepper, t0, tf, max_steps)
     q0, v0, state = _initial_state(model, n, q0, v0, state0, events)
     bound = model.bind(state) if events else model
-    rec = Recorder(bound, monitors)
+    start = _constrained_start(stepper, bound, caps, events, t0, q0, v0)   # bad input raises here
+    rec = Recorder(bound, monitors, constrained=start is not None)
     state_keys = tuple(state) if events else ()
 
     wall, cpu = time.perf_counter(), time.process_time()
@@ -220,10 +248,14 @@ def integrate(stepper: Stepper, model: Model, t_span: tuple[float, float], t_eva
     t = t0
     bar = _Progress(progress, t0, tf, getattr(stepper, "name", "run"))
     try:
-        a0, reason = consistent_acceleration(bound, t0, q0, v0)
-        if a0 is None:
-            raise _Failed(f"initial acceleration at t = {t0:g} failed: {reason}")
-        stepper.initialize(bound, t0, q0, v0, a0, tf, want_quadrature=bool(rec.monitors))
+        if start is None:
+            a0, reason = consistent_acceleration(bound, t0, q0, v0)
+            if a0 is None:
+                raise _Failed(f"initial acceleration at t = {t0:g} failed: {reason}")
+            stepper.initialize(bound, t0, q0, v0, a0, tf, want_quadrature=bool(rec.monitors))
+        else:
+            q0, v0, a0 = start.q, start.v, start.a
+            stepper.initialize(bound, t0, q0, v0, a0, tf, want_quadrature=bool(rec.monitors), lam0=start.lam)
         rec.start(t0, q0, v0, a0)
         j = 0
         if t_out is None or t_out[0] <= t0:
@@ -287,6 +319,8 @@ def integrate(stepper: Stepper, model: Model, t_span: tuple[float, float], t_eva
     stats = dict(stepper.stats)     # the stepper's counters, "steps" among them; the driver's beside
     stats.update(model_events=events_n, restarts=restarts,
                  wall_time=time.perf_counter() - wall, cpu_time=time.process_time() - cpu)
+    if start is not None:
+        stats.update(initial_correction_q=start.dq, initial_correction_v=start.dv)
     return rec.result(n, state_keys=state_keys, status=status, message=message, stats=stats, t_fail=t_fail,
                       method=getattr(stepper, "name", type(stepper).__name__), options=stepper.options(),
                       model=describe_model(model))

@@ -67,6 +67,10 @@ What holds exactly (to round-off and the Newton tolerance)
   ratio of two small numbers, and Newton needs more iterations.
 * supports break the symmetries: then no momentum is conserved and the Gonzalez correction
   is the plain mass-metric one; energy still holds exactly.
+* constrained models (capability ``"constraints"``, joints of :mod:`ancfdae.joints`): the constraint
+  forces enter through the midpoint Jacobian ``G(q_m)``, an exact discrete derivative for rows at most
+  quadratic in ``q`` (``constraint_degree <= 2``, refused otherwise); energy is kept and ``g(t1, q1) = 0``
+  holds to round-off (:mod:`ancfdae.integrators._em_constrained`).
 * BE3D: not supported. Its mass matrix depends on the slopes (the rotary inertia of the
   cross-section), so the kinetic energy is not ``v^T M v / 2`` with a constant ``M`` and the
   midpoint velocity update no longer yields the energy identity; a discrete gradient of its
@@ -80,7 +84,9 @@ import scipy.sparse.linalg as spla
 
 from ancfdae import _validate as validate
 from ancfdae._scale import ENERGY_ROUNDOFF
+from ancfdae.integrators._alpha_index3 import mass_scale
 from ancfdae.integrators._discrete_gradient import AVFGradient, GonzalezGradient
+from ancfdae.integrators._em_constrained import constrained_em_step
 from ancfdae.integrators._newton_records import NewtonOptions
 from ancfdae.integrators.newton_stepper import NewtonStepper
 from ancfdae.integrators.protocol import Quadrature, StepOutcome
@@ -127,6 +133,7 @@ class EnergyMomentum(NewtonStepper):
     fixed_step = True
     FLOOR_ROUNDOFF = ENERGY_ROUNDOFF
     FLOOR_UPDATE = "replace"     # the floor of the latest Jacobian (a running maximum moved energy and flying3d)
+    handles_constraints = True
 
     def __init__(self, model: Model, h: float, *, discrete_gradient: str = "auto", angular_momentum: bool = True,
                  newton: NewtonOptions | dict | None = None) -> None:
@@ -141,6 +148,11 @@ class EnergyMomentum(NewtonStepper):
                              "potential, potential_gradient, nonconservative_force) for method "
                              f"'energy-momentum'; {type(model).__name__} declares "
                              f"{sorted(capabilities(model))}.")
+        if "constraints" in capabilities(model) and getattr(model, "constraint_degree", None) not in (1, 2):
+            raise ValueError("`model` constraints must be at most quadratic in q (constraint_degree 1 or 2) for "
+                             "method 'energy-momentum', whose midpoint constraint Jacobian is then an exact "
+                             f"discrete derivative; got constraint_degree="
+                             f"{getattr(model, 'constraint_degree', None)!r}.")
         super().__init__(model, h, newton=DEFAULT_NEWTON if newton is None else newton)
         validate.choice("discrete_gradient", discrete_gradient, DISCRETE_GRADIENTS)
         degree = getattr(model, "potential_degree", None)
@@ -174,6 +186,11 @@ class EnergyMomentum(NewtonStepper):
         if self.model.wrapped is not self._model_bound:
             self._bind(self.model.wrapped)
         self._check_split(self.t, self.q, self.v)
+        self._constrained = "constraints" in capabilities(self.model)
+        if self._constrained:
+            self._mscale = mass_scale(self._M)
+            if self.lam is None:
+                self.lam = np.zeros(self.model.n_constraints)
 
     def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model) -> None:
         """Carry on from a state a model event changed (grid and Newton matrix kept; a new model rebound).
@@ -204,6 +221,8 @@ class EnergyMomentum(NewtonStepper):
     # -- one step ------------------------------------------------------------------------
     def _step_impl(self, t0, h):
         """One discrete-gradient midpoint step from the current state; the state is left unchanged."""
+        if self._constrained:
+            return constrained_em_step(self, t0, h)
         q0, v0 = self.q, self.v
         tm, t1 = t0 + 0.5 * h, t0 + h
         model, dg, M, c = self.model, self._dg, self._M, 2.0 / (h * h)

@@ -61,6 +61,9 @@ class Integrator(ABC):
         Start and end of the run.
     n_steps : int
         Steps accepted since :meth:`initialize`.
+    lam : ndarray or None
+        The current multipliers of a constrained model (from ``initialize(..., lam0=...)``, then each
+        accepted ``StepOutcome.lam``); None otherwise.
     """
 
     name: str = "integrator"

@@ -18,6 +18,12 @@ All three are one scheme, the generalized-alpha method of Chung and Hulbert
   ``gamma = 1/2 - am + af``, ``beta = (1 - am + af)^2 / 4`` (order 2,
   unconditionally stable, high-frequency dissipation controlled by rho_inf).
 
+Constrained models (capability ``"constraints"``): index 3 in the Arnold-Bruls form, scaled, with the
+true acceleration in the equilibrium at ``t_{n+1}`` (:mod:`ancfdae.integrators._alpha_index3`); ``q``,
+``v`` and the multipliers second order for ``rho_inf < 1``. Newmark with ``gamma = 1/2`` has no
+numerical dissipation and its multipliers carry an undamped period-2h oscillation on index 3: a warning
+is logged.
+
 The residual is evaluated at the weighted state (not as weighted forces),
 which keeps the scheme on the contract alone, with one residual call per
 Newton iteration; for nonlinear problems it is the state-averaged variant of
@@ -29,13 +35,20 @@ from __future__ import annotations
 
 import numbers
 
+import numpy as np
+
+import logging
+
 from ancfdae.integrators._affine import affine2, affine3, newmark_predict
+from ancfdae.integrators._alpha_index3 import index3_step, mass_scale
 from ancfdae.integrators._newton_records import NewtonOptions
 from ancfdae.integrators.newton_stepper import NewtonStepper
 from ancfdae.integrators.protocol import StepOutcome
-from ancfdae.problem import Model
+from ancfdae.problem import Model, capabilities
 
 __all__ = ["Newmark", "HHTAlpha", "GeneralizedAlpha"]
+
+_log = logging.getLogger("ancfdae")
 
 
 def _param(name, value, low, high):
@@ -48,6 +61,7 @@ class _AlphaFamily(NewtonStepper):
     """The shared generalized-alpha step (parameters validated by the subclasses)."""
 
     order = 2
+    handles_constraints = True
 
     def __init__(self, model, h, beta, gamma, alpha_m, alpha_f, newton):
         super().__init__(model, h, newton=newton)
@@ -65,7 +79,34 @@ class _AlphaFamily(NewtonStepper):
         o.update(beta=self.beta, gamma=self.gamma, alpha_m=self.alpha_m, alpha_f=self.alpha_f)
         return o
 
+    def _setup(self):
+        """The Newton set-up; on a constrained model the algorithmic acceleration starts at ``a0``."""
+        super()._setup()
+        self._constrained = "constraints" in capabilities(self.model)
+        if self._constrained:
+            self._ah = self.a.copy()
+            self._mscale = mass_scale(self.model.mass(self.q))
+            if self.lam is None:
+                self.lam = np.zeros(self.model.n_constraints)
+            if self.alpha_m == self.alpha_f and self.gamma == 0.5:
+                _log.warning("%s on a constrained model (index 3) without numerical dissipation: the multipliers "
+                             "carry an undamped period-2h oscillation; prefer rho_inf < 1.", self.name)
+
+    def accept(self, outcome: StepOutcome) -> None:
+        """Make ``outcome`` the current state (and, constrained, its algorithmic acceleration).
+
+        Parameters
+        ----------
+        outcome : StepOutcome
+            A successful step.
+        """
+        super().accept(outcome)
+        if self._constrained:
+            self._ah = self._ah_next
+
     def _step_impl(self, t, h):
+        if self._constrained:
+            return index3_step(self, t, h)
         am, af, b, g, model = self.alpha_m, self.alpha_f, self.beta, self.gamma, self.model
         ta = t + (1.0 - af) * h
         # q_{n+1}, v_{n+1} and the weighted state are affine in x = a_{n+1}: their constant parts

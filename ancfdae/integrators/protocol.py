@@ -60,7 +60,8 @@ class StepOutcome:
     message : str
         Why the step failed (empty on success).
     lam : ndarray, shape (n_constraints,), or None
-        The method's own multipliers at ``t`` for a model with the ``"constraints"`` capability.
+        A constrained model only (capability ``"constraints"``): the method's own multipliers at ``t``
+        (what it carries into the next step). The driver reports multipliers recomputed from ``(t, q, v)``.
     """
 
     ok: bool
@@ -104,6 +105,12 @@ class Stepper(Protocol):
     consistent_restart : bool
         True when a restart after a model event needs an acceleration consistent with the changed
         state (IDA); else the step's own is passed.
+    handles_constraints : bool, optional
+        True when the stepper integrates models with the ``"constraints"`` capability
+        (:class:`ancfdae.problem.ConstrainedModel`): it adds ``G^T lam`` to the residual and imposes the
+        constraints itself, takes the consistent multipliers as ``initialize(..., lam0=...)`` and returns
+        its own in ``StepOutcome.lam``. The driver refuses a constrained model for a stepper without it
+        (absent means False), and passes ``lam0`` only to steppers that declare it.
     t : float
         The current time (after ``initialize``).
     q, v, a : ndarray
@@ -129,7 +136,10 @@ class Stepper(Protocol):
 
     def initialize(self, model: Model, t0: float, q0: np.ndarray, v0: np.ndarray, a0: np.ndarray,
                    t_bound: float, *, want_quadrature: bool = False) -> None:
-        """Take the model to evaluate, the initial state (``a0`` consistent) and the end of the run."""
+        """Take the model to evaluate, the initial state (``a0`` consistent) and the end of the run.
+
+        A stepper with ``handles_constraints`` also takes the keyword ``lam0`` (the consistent multipliers).
+        """
         ...
 
     def step(self) -> StepOutcome:

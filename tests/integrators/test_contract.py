@@ -1,4 +1,4 @@
-"""One contract, every integrator (design.md Sect. 5): run over the test models of toy_models.py."""
+"""One contract, every integrator: run over the test models of toy_models.py."""
 import numpy as np
 import pytest
 

@@ -23,11 +23,13 @@ import scipy.sparse as sp
 from numpy.typing import ArrayLike
 
 from ..._validate import check_shape
+from ...attachment import Attachment
 from ...loads import DistributedLoad, Gravity, PointForce, PointMoment
 from ...problem import Energy, JacobianBlocks
 from ..element import Element
 from . import checks, describe as description, mesh
 from .assembly import Assembler
+from .attach import beam_attachment
 from .loads import LoadSet, load_sequence
 from .potential import symmetry_generators
 from .stages import StageEvaluator
@@ -141,12 +143,8 @@ class Beam:
 
     @classmethod
     def from_description(cls, model: dict) -> Beam:
-        """The beam of a :meth:`describe` dict (e.g. ``Result.model`` of a result file), without its loads.
-
-        Same element, material, section, nodes and supports, hence the same
-        coordinates and reference configuration; see
-        :func:`~ancfdae.models.beam.describe.beam_arguments` for the errors.
-        """
+        """The beam of a :meth:`describe` dict (e.g. ``Result.model`` of a result file), without its loads: the same
+        coordinates and reference configuration; see :func:`~ancfdae.models.beam.describe.beam_arguments`."""
         element, kwargs = description.beam_arguments(model)
         return cls(element, **kwargs)
 
@@ -177,14 +175,18 @@ class Beam:
         r = (self.point_matrix(s) @ self.expand(q)).reshape(-1, self.element.dim)
         return r[0] if np.ndim(s) == 0 else r
 
+    def attachment(self, where: int | float | dict) -> Attachment:
+        """Where a joint holds the beam: node ``where`` (int, negative from the end) or the axis point at arc
+        length ``where`` (float, or ``{"s": float}``), as an :class:`ancfdae.attachment.Attachment` on the free
+        coordinates (supports enter its offsets); see :mod:`.attach`."""
+        return beam_attachment(self, where)
+
     def describe(self) -> dict:
-        """JSON-able description (element, material, section, mesh, supports, loads); see
-        :func:`ancfdae.models.beam.describe.describe`."""
+        """JSON-able description (element, material, section, mesh, supports, loads); see :mod:`.describe`."""
         return description.describe(self)
 
     def dof_labels(self) -> tuple[np.ndarray, np.ndarray]:
-        """Node index and coordinate name of each free coordinate; see
-        :func:`ancfdae.models.beam.describe.dof_labels`."""
+        """Node index and coordinate name of each free coordinate; see :func:`.describe.dof_labels`."""
         return description.dof_labels(self)
 
     # -- capabilities and event state (ancfdae.problem.CAPABILITIES) -------

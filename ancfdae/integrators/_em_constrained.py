@@ -1,0 +1,105 @@
+"""One energy-momentum step on a constrained model: the constraint forces through a discrete derivative.
+
+For ``M a + grad P - f_nc + G^T lam = 0``, ``g(t, q) = 0`` the step (Gonzalez, J. Nonlinear Sci. 9:293,
+1999, for holonomic constraints) is::
+
+    q1 - q0 = h (v0 + v1) / 2
+    M (v1 - v0) = -h DP(q0, q1) + h f_nc(t_m, q_m) - h G_d^T lam,      g(t1, q1) = 0
+    G_d = (G(t0, q_m) + G(t1, q_m)) / 2,      q_m = (q0 + q1) / 2
+
+For constraints at most quadratic in ``q`` with time only in the linear part (every joint of
+:mod:`ancfdae.joints`, ``constraint_degree <= 2``), ``G(t, q_m) (q1 - q0) = g(t, q1) - g(t, q0)`` *exactly*:
+``G(q_m)`` is a discrete derivative with no correction. Multiplying by ``v_m = (q1 - q0)/h`` gives::
+
+    E1 - E0 = h f_nc . v_m - lam . (G_d (q1 - q0)),
+    G_d (q1 - q0) = [g(t0, q1) - g(t0, q0) + g(t1, q1) - g(t1, q0)] / 2
+
+so with ``g(t0, q0) = g(t1, q1) = 0`` a scleronomic joint does no work (energy kept to round-off) and
+``g(t1, q1) = 0`` holds to the Newton tolerance at every step; a prescribed motion does exactly
+``lam . Delta_t g`` (``Delta_t g = [g(t1, q1) - g(t0, q1) + g(t1, q0) - g(t0, q0)] / 2``). The velocity
+constraint ``G v + g_t = 0`` is not imposed (it would break the energy identity): exact for linear rows
+(pins), ``O(h^2)`` for quadratic ones.
+
+Unknowns ``x = [y, mu]``, ``y = q1 - q0 - h v0``, ``lam = s m mu`` with ``s = 2 / h^2`` and ``m`` the mean mass
+diagonal; rows ``[dyn; s m g(t1, q1)]`` in force units (as in :mod:`._alpha_index3`). Exact matrix::
+
+    [[s M + dDP/dq1 - K_nc / 2 + H_d(lam) / 2,  s m G_d^T],      H_d = (H(t0, q_m, lam) + H(t1, q_m, lam)) / 2
+     [s m G(t1, q1),                            0        ]]
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from ancfdae.integrators.protocol import Quadrature, StepOutcome
+
+__all__ = ["constrained_em_step", "constrained_em_equations"]
+
+
+def constrained_em_equations(st, t0: float, h: float):
+    """The step's Newton system ``(residual, jacobian, x0)`` for ``st`` (an
+    :class:`~ancfdae.integrators.EnergyMomentum` on a constrained model); ``x = [y, mu]``."""
+    q0, v0 = st.q, st.v
+    tm, t1 = t0 + 0.5 * h, t0 + h
+    model, dg, M, c = st.model, st._dg, st._M, 2.0 / (h * h)
+    n = q0.size
+    sm = c * st._mscale
+    dg.start(tm, q0)
+    hv0 = h * v0
+
+    def G_d(qm):
+        return 0.5 * (model.constraint_jacobian(t0, qm) + model.constraint_jacobian(t1, qm))
+
+    def residual(x):
+        y, lam = x[:n], sm * x[n:]
+        u = hv0 + y
+        qm = q0 + 0.5 * u
+        f, _ = model.nonconservative_force(tm, qm, False)
+        dyn = c * (M @ y) + dg.gradient(q0 + u) - f + G_d(qm).T @ lam
+        return np.concatenate([dyn, sm * model.constraints(t1, q0 + u)])
+
+    def jacobian(x):
+        y, lam = x[:n], sm * x[n:]
+        u = hv0 + y
+        qm = q0 + 0.5 * u
+        _, Kf = model.nonconservative_force(tm, qm, True)
+        J = dg.jacobian(q0 + u)
+        Gd, G1 = sm * sp.csr_matrix(G_d(qm)), sm * sp.csr_matrix(model.constraint_jacobian(t1, q0 + u))
+        # the round-off of the gradient rows and of the scaled constraint rows (a model without stiffness,
+        # such as point masses on rods, has only the latter)
+        floor = max(st.floor_of(J, q0 + u), st.floor_of(G1, q0 + u))
+        H = 0.25 * (model.constraint_force_jacobian(t0, qm, lam) + model.constraint_force_jacobian(t1, qm, lam))
+        m = G1.shape[0]
+        if sp.issparse(J):
+            A = sp.csr_matrix(c * M + J - 0.5 * Kf + H)
+            return sp.bmat([[A, Gd.T], [G1, sp.csr_matrix((m, m))]], format="csr"), floor
+        A = J + (c * M - 0.5 * Kf + H).toarray()
+        return np.block([[A, Gd.T.toarray()], [G1.toarray(), np.zeros((m, m))]]), floor
+
+    return residual, jacobian, np.concatenate([st._predict(h), st.lam / sm])
+
+
+def constrained_em_step(st, t0: float, h: float) -> StepOutcome:
+    """One step of ``st`` (an :class:`~ancfdae.integrators.EnergyMomentum` on a constrained model)."""
+    residual, jacobian, x0 = constrained_em_equations(st, t0, h)
+    out = st._solve(residual, jacobian, x0)
+    if not out.converged:
+        return StepOutcome.failure(f"Newton: {out.message}")
+    q0, v0, n, model = st.q, st.v, st.q.size, st.model
+    tm, t1 = t0 + 0.5 * h, t0 + h
+    hv0 = h * v0
+    y, lam = out.x[:n], 2.0 / (h * h) * st._mscale * out.x[n:]
+    q1 = q0 + (hv0 + y)
+    v1 = v0 + (2.0 / h) * y
+    # The acceleration at t1 for the predictor and the interpolation only: M a1 = -r(t1, q1, v1, 0) - G^T lam,
+    # with the step's (midpoint) multipliers -- O(h) off the KKT value, which the driver reports.
+    rhs = -np.asarray(model.residual(t1, q1, v1, np.zeros_like(q1)), dtype=float) \
+        - model.constraint_jacobian(t1, q1).T @ lam
+    a1 = st._Mlu.solve(rhs)
+    if not np.all(np.isfinite(a1)):
+        return StepOutcome.failure(f"the acceleration at t = {t1:.9g} is not finite (the model's residual there)")
+    quad = None
+    if st.want_quadrature:
+        quad = Quadrature(t=np.array([tm]), q=(q0 + 0.5 * (hv0 + y))[None, :], v=(v0 + y / h)[None, :],
+                          w=np.array([h]))
+    return StepOutcome(ok=True, t=t1, q=q1, v=v1, a=a1, quadrature=quad, lam=lam)

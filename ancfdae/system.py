@@ -1,0 +1,172 @@
+"""Several bodies joined by joints: :class:`System`, a Model with the ``"constraints"`` capability.
+
+The system stacks the bodies' coordinates (body 0 first), so its mass, stiffness and damping are
+block-diagonal with the bodies' fixed patterns, and adds the constraint rows: every body's own (the
+``"constraints"`` of a body, e.g. a rigid body's orthonormal directors) first, then the joints' in the order
+given (:mod:`ancfdae.joints`). The equations are ``r(t, q, v, a) + G^T lam = 0``, ``g(t, q) = 0``
+(:mod:`ancfdae.problem`); the residual has no ``G^T lam`` term: the integrator adds it.
+"""
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import scipy.sparse as sp
+
+from ancfdae.constrained import dependent_rows
+from ancfdae.joints.assembled import ConstraintSet
+from ancfdae.joints.base import Frame, Joint
+from ancfdae.joints.rows import Affine, Rows
+from ancfdae.problem import capabilities
+from ancfdae.system_stack import BodyStack
+
+__all__ = ["System"]
+
+
+class System(BodyStack):
+    """Bodies (each a Model: :class:`~ancfdae.models.Beam`, a rigid body) joined by joints.
+
+    Parameters
+    ----------
+    bodies : sequence of Model
+        The bodies; a joint names a body by the object itself. A body a joint holds must offer
+        ``attachment(where)`` (:class:`ancfdae.attachment.Attachment`).
+    joints : sequence of Joint
+        :mod:`ancfdae.joints` objects.
+    t0 : float
+        Time of the initial state, where ground points default and the rank of ``G`` is checked.
+
+    Attributes
+    ----------
+    n_dof, n_constraints : int
+    offsets : ndarray
+        First coordinate of each body in ``q``.
+    constraint_labels : tuple of str
+        One per row: ``"joint name[k]"`` (body rows: ``"body i: label"``).
+
+    Raises
+    ------
+    ValueError
+        A joint naming a body not in ``bodies`` or a node it lacks, a joint of the wrong dimension, redundant
+        joints (rows of ``G`` that depend on earlier rows at the initial state: named).
+    """
+
+    def __init__(self, bodies: Sequence, joints: Sequence[Joint] = (), *, t0: float = 0.0) -> None:
+        super().__init__(bodies)
+        joints = list(joints)
+        for k, j in enumerate(joints):
+            if not isinstance(j, Joint):
+                raise TypeError(f"`joints[{k}]` must be a joint of ancfdae.joints, got {j!r:.100}.")
+        self.joints = joints
+        q0, _ = self.initial_state()
+        n = self.n_dof
+        rows = Rows(n)
+        for k, joint in enumerate(joints):
+            frames = tuple(self._frame(k, joint, arg, side) for arg, side in zip(joint.side_args, joint.sides))
+            rows.extend(joint.rows(frames, q0, n))
+        self._joint_set = ConstraintSet(rows)
+        self._body_rows = [(b, off, b.n_constraints) for b, off in zip(self.bodies, self.offsets)
+                           if "constraints" in capabilities(b)]
+        self.n_constraints = sum(m for _, _, m in self._body_rows) + self._joint_set.m
+        self.constraint_labels = tuple(
+            [f"body {self.bodies.index(b)}: {lab}" for b, _, m in self._body_rows
+             for lab in getattr(b, "constraint_labels", [f"row {i}" for i in range(m)])]
+            + list(self._joint_set.labels))
+        self.rheonomic = self._joint_set.rheonomic or any(getattr(b, "rheonomic", True) for b, _, _ in self._body_rows)
+        if self.n_constraints:
+            drop = dependent_rows(self.constraint_jacobian(t0, q0))
+            if drop:
+                names = ", ".join(self.constraint_labels[i] for i in drop)
+                raise ValueError(f"`joints` are redundant: {len(drop)} constraint row(s) depend on earlier ones at "
+                                 f"the initial state: {names}. Remove the joint(s) that repeat a constraint "
+                                 "(e.g. a pin given twice, or a ground pin on a clamped node).")
+
+    def _frame(self, k: int, joint: Joint, arg: str, side) -> Frame:
+        if isinstance(side, str):
+            return Frame(None, (), "ground", None)
+        body, where = side
+        i = next((i for i, b in enumerate(self.bodies) if b is body), None)
+        if i is None:
+            raise ValueError(f"`joints[{k}]` ({joint.kind}) side `{arg}` names a body that is not in `bodies` "
+                             f"(got {type(body).__name__} object); pass the body objects given to System.")
+        if not callable(getattr(body, "attachment", None)):
+            raise ValueError(f"`joints[{k}]` side `{arg}`: body {i} ({type(body).__name__}) offers no attachment().")
+        try:
+            att = body.attachment(where)
+        except ValueError as exc:
+            raise ValueError(f"`joints[{k}]` ({joint.kind}) side `{arg}` on body {i}: {exc}") from None
+        n, off, nb = self.n_dof, self.offsets[i], body.n_dof
+
+        def embed(X, x0):
+            X = sp.csr_matrix(X)
+            cols = sp.csr_matrix((np.ones(nb), (np.arange(nb), off + np.arange(nb))), shape=(nb, n))
+            return Affine(sp.csr_matrix(X @ cols), np.asarray(x0, dtype=float))
+        return Frame(embed(att.position, att.offset),
+                     tuple(embed(D, d0) for D, d0 in zip(att.axes, att.axes_offset)),
+                     f"body {i} {att.label}", att.dim)
+
+    # -- the "constraints" capability (ancfdae.problem.CAPABILITIES) -----------------------------
+    def constraints(self, t: float, q: np.ndarray) -> np.ndarray:
+        """``g(t, q)``, shape (n_constraints,): bodies' rows first, then the joints'."""
+        parts = [b.constraints(t, q[o:o + b.n_dof]) for b, o, _ in self._body_rows]
+        return np.concatenate(parts + [self._joint_set.g(t, q)])
+
+    def _stack_rows(self, blocks, joint_part):
+        if not blocks:
+            return joint_part
+        n = self.n_dof
+        shifted = [sp.csr_matrix((sp.csr_matrix(B).data, sp.csr_matrix(B).indices + o, sp.csr_matrix(B).indptr),
+                                 shape=(B.shape[0], n)) for B, o in blocks]
+        return sp.vstack(shifted + [joint_part], format="csr")
+
+    def constraint_jacobian(self, t: float, q: np.ndarray) -> sp.csr_matrix:
+        """``G = dg/dq`` on a fixed pattern, shape (n_constraints, n_dof)."""
+        blocks = [(b.constraint_jacobian(t, q[o:o + b.n_dof]), o) for b, o, _ in self._body_rows]
+        return self._stack_rows(blocks, self._joint_set.G(t, q))
+
+    def constraint_force_jacobian(self, t: float, q: np.ndarray, lam: np.ndarray) -> sp.csr_matrix:
+        """``d(G^T lam)/dq``, shape (n_dof, n_dof); constant in ``q`` (every joint is at most quadratic)."""
+        mb = self.n_constraints - self._joint_set.m
+        H = self._joint_set.H(lam[mb:])
+        if not self._body_rows:
+            return H
+        blocks, r = [], 0
+        for b, o, m in self._body_rows:
+            blocks.append((b.constraint_force_jacobian(t, q[o:o + b.n_dof], lam[r:r + m]), o))
+            r += m
+        return sp.csr_matrix(H + self.block_diagonal(blocks))
+
+    def constraint_rates(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(g_t, gamma)``: ``G v + g_t = 0`` and ``G a = gamma = -(Z(v) v + 2 G_t v + g_tt)``."""
+        parts = [b.constraint_rates(t, q[o:o + b.n_dof], v[o:o + b.n_dof]) for b, o, _ in self._body_rows]
+        gt, gam = self._joint_set.rates(t, q, v)
+        return (np.concatenate([p[0] for p in parts] + [gt]), np.concatenate([p[1] for p in parts] + [gam]))
+
+    def constraint_velocity_jacobian(self, t: float, q: np.ndarray, v: np.ndarray) -> sp.csr_matrix:
+        """``d(G v + g_t)/dq = Z(v) + G_t`` on G's pattern (index-2 formulations); beyond the contract."""
+        blocks = []
+        for b, o, _ in self._body_rows:
+            fn = getattr(b, "constraint_velocity_jacobian", None)
+            if fn is None:
+                raise TypeError(f"body {self.bodies.index(b)} ({type(b).__name__}) has no "
+                                "constraint_velocity_jacobian(t, q, v).")
+            blocks.append((fn(t, q[o:o + b.n_dof], v[o:o + b.n_dof]), o))
+        return self._stack_rows(blocks, self._joint_set.velocity_jacobian(t, q, v))
+
+    @property
+    def constraint_degree(self) -> int | None:
+        """2: every row is at most quadratic in ``q`` with constant ``A_i`` (bodies' rows: their own)."""
+        degrees = [getattr(b, "constraint_degree", None) for b, _, _ in self._body_rows]
+        return None if any(d is None for d in degrees) else max([2] + degrees)
+
+    @property
+    def capabilities(self) -> frozenset:
+        """``"constraints"`` and what every body offers (``potential``, ``residual_jacobian``, ...)."""
+        return self.shared_capabilities() | {"constraints"}
+
+    def describe(self) -> dict:
+        """JSON-able description: the bodies' and the constraint rows' labels."""
+        return {"system": {"bodies": [b.describe() if callable(getattr(b, "describe", None)) else
+                                      {"type": type(b).__name__} for b in self.bodies],
+                           "offsets": [int(o) for o in self.offsets],
+                           "constraint_labels": list(self.constraint_labels)}}
