@@ -39,7 +39,7 @@ import scipy.sparse as sp
 from ancfdae import _validate as validate
 from ancfdae.integrators._affine import affine2, stage_constants, stage_states
 from ancfdae.integrators._linsolve import StageMatrix
-from ancfdae.integrators._constraint_terms import consistent_multipliers, constraint_rows
+from ancfdae.constrained import multipliers
 from ancfdae.integrators._newton_records import NewtonOptions
 from ancfdae.integrators.lobatto_constrained import GGLStages, ggl_step
 from ancfdae.integrators.newton_stepper import NewtonStepper
@@ -202,10 +202,23 @@ class LobattoIIIA(NewtonStepper):
         self._w_cache = None
         self._stages = "residual_stages" in capabilities(self.model)   # declared, forwarded by the proxy
         self._ggl = None
-        if constraint_rows(self.model):   # constrained: the GGL stage system (lobatto_constrained)
+        if "constraints" in capabilities(self.model):   # constrained: the GGL stage system (lobatto_constrained)
             if self.lam is None:          # no multipliers given: (a0, lam0) from the KKT system
-                self.a, self.lam = consistent_multipliers(self.model, self.t, self.q, self.v)
+                self.a, self.lam = multipliers(self.model, self.t, self.q, self.v)
             self._ggl = GGLStages(self)
+
+    def restart(self, t, q, v, a, model) -> None:
+        """After a model event; a constrained model gets ``(a, lam)`` consistent with the changed state (the
+        first stage of the next step is ``a``).
+
+        Parameters
+        ----------
+        t, q, v, a, model
+            As for :meth:`~ancfdae.integrators.FixedStepIntegrator.restart`.
+        """
+        super().restart(t, q, v, a, model)
+        if self._ggl is not None:
+            self.a, self.lam = multipliers(self.model, self.t, self.q, self.v)
 
     # -- predictor -------------------------------------------------------------------------
     def _guess(self, h):
