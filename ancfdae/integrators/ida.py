@@ -113,6 +113,10 @@ class IDA(Integrator):
     has a stationary initial state: IDA's first step then scales with the span (a run over
     [0, 1e6] s stepped over a 3 s load); give ``max_step`` for long spans.
 
+    Constrained models (capability ``"constraints"``): the GGL form ``y = [q, v, lam, mu]`` with the
+    multipliers out of the error test (:mod:`ancfdae.integrators.ida_constrained`, which says why and
+    what it costs: the constraints hold to about the position tolerance).
+
     Statistics: ``newton_iterations`` counts calls of the residual, which SUNDIALS' Newton
     solver evaluates exactly once per iteration (the Jacobian is ours, no difference
     quotients); ``jacobian_evals`` = ``factorizations`` counts calls of the Jacobian (each is

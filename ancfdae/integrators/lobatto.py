@@ -156,6 +156,14 @@ class LobattoIIIA(NewtonStepper):
         depends on the contraction rate, not on the initial residual: on
         the 25-element BE2D pendulum (h = 1e-4) "extrapolate" took 5.0
         instead of 4.7 iterations per step.
+
+    Notes
+    -----
+    A model with the ``"constraints"`` capability is integrated in the stabilised index-2 (GGL) form
+    with a reduced stage system (:mod:`ancfdae.integrators.lobatto_constrained`): order 4 in q and v
+    on linear, quadratic and rheonomic constraints, ``g`` and ``G v + g_t`` held at every step to the
+    Newton tolerance; the step's multipliers are returned in ``StepOutcome.lam`` (the predictor is
+    always "constant" there).
     """
 
     handles_constraints = True
