@@ -215,7 +215,7 @@ class LobattoIIIA(NewtonStepper):
                 self.a, self.lam = multipliers(self.model, self.t, self.q, self.v)
             self._ggl = GGLStages(self)
 
-    def restart(self, t, q, v, a, model) -> None:
+    def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model) -> None:
         """After a model event; a constrained model gets ``(a, lam)`` consistent with the changed state (the
         first stage of the next step is ``a``).
 
