@@ -3,7 +3,8 @@
 The chapter cited throughout is Gerstmayr, Humer, Gruber, Nachbagauer, "The
 Absolute Nodal Coordinate Formulation" (Sects. 2-5, Eqs. 1-115).
 
-Submodules: :mod:`ancfdae.models` (elements and the beam), :mod:`ancfdae.integrators`,
+Submodules: :mod:`ancfdae.models` (elements and the beam), :mod:`ancfdae.bodies` (rigid bodies),
+:mod:`ancfdae.integrators`,
 :mod:`ancfdae.export` (ParaView), :mod:`ancfdae.plot` (matplotlib pictures and animations).
 """
 import logging
@@ -14,9 +15,10 @@ from .problem import Energy, JacobianBlocks, Model
 from .static import StaticResult, solve_static
 from .simulate import METHODS, simulate
 from .result import Result, ResultFileError
-from .monitors import ConstraintMonitor, EnergyMonitor, PointSensor, Probe
+from .monitors import ConstraintMonitor, DirectorGeometry, EnergyMonitor, PointSensor, Probe
 from .system import System
 from . import joints
+from .bodies import RigidBody
 
 __version__ = "0.1.0"
 
@@ -30,5 +32,5 @@ __all__ = [
     "Model", "JacobianBlocks", "Energy",
     "solve_static", "StaticResult",
     "simulate", "METHODS", "Result", "ResultFileError", "EnergyMonitor", "PointSensor", "Probe",
-    "System", "joints", "ConstraintMonitor",
+    "DirectorGeometry", "System", "joints", "ConstraintMonitor", "RigidBody",
 ]

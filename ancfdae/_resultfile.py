@@ -1,6 +1,6 @@
 """Result files: NetCDF4/HDF5 through xarray, readable without ancfdae.
 
-Layout of a file (format ``ancfdae.Result/2``)
+Layout of a file (format ``ancfdae.Result/3``)
 ----------------------------------------------
 Dimensions ``time`` (outputs) and ``dof`` (free coordinates), with the
 coordinates ``time``, ``node`` (node index of each coordinate) and
@@ -14,6 +14,16 @@ coordinates ``time``, ``node`` (node index of each coordinate) and
 readable copies ``element``, ``formulation``, ``material``, ``section``,
 ``loads``, ``unit_system``; the mesh also as the variables ``reference_nodes``
 ``(mesh_node, space)`` and ``element_nodes`` ``(element, element_node)``.
+
+Integrity (new in format 3)
+---------------------------
+Every numeric variable carries HDF5's Fletcher-32 checksum and the global attribute
+``checksums`` hashes the attributes, the layout and the text variables
+(:mod:`ancfdae._filecheck`); on load the dimensions are also checked against the stored beam
+description (``n_dof``, the coordinate labels, the mesh). A damaged file raises
+:class:`ResultFileError` naming the file and the variable or attribute, never loads other values.
+Files are written to a temporary name in the target folder and renamed, so a killed writer leaves
+no half file under the final name. Format-2 files (no checksums) are still read.
 
 Engine
 ------
@@ -31,15 +41,20 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from pathlib import Path
 
 import numpy as np
+
+from . import _filecheck
 
 __all__ = ["ResultFileError", "FORMAT", "ENGINE", "FIELDS", "describe_model", "to_dataset", "from_dataset", "write",
            "read"]
 
 #: Format tag written into every result file.
-FORMAT = "ancfdae.Result/2"
+FORMAT = "ancfdae.Result/3"
+#: Earlier formats still read: format 2 is format 3 without the checksums.
+_LEGACY = ("ancfdae.Result/2",)
 #: xarray engine used to write (see the module docstring for the measurement).
 ENGINE = "netcdf4"
 #: The fields of a result, as :func:`to_dataset` takes them and :func:`from_dataset` returns them
@@ -175,6 +190,7 @@ def to_dataset(fields):
     ds["time"].attrs["long_name"] = "output time"
     for name, long in (("q", "coordinates"), ("v", "velocities"), ("a", "accelerations")):
         ds[name].attrs["long_name"] = long
+    ds.attrs[_filecheck.CHECKSUM_ATTR] = json.dumps(_filecheck.checksums(ds), sort_keys=True)
     return ds
 
 
@@ -184,19 +200,39 @@ def _path(path) -> Path:
 
 
 def write(path, fields, engine: str = ENGINE) -> Path:
-    """Write a result's ``fields`` (see :func:`to_dataset`) to ``path``.
+    """Write a result's ``fields`` (see :func:`to_dataset`) to ``path``, atomically.
 
-    ``.nc`` is added unless ``path`` ends in .nc, .nc4 or .h5.
+    ``.nc`` is added unless ``path`` ends in .nc, .nc4 or .h5. The file is written under a
+    temporary name in the same folder and renamed over ``path`` once complete.
 
     Returns
     -------
     pathlib.Path
         The path written.
+
+    Raises
+    ------
+    ValueError
+        If the folder of ``path`` does not exist or is not writable, or ``path`` is a folder.
     """
     path = _path(path)
+    folder = path.parent
+    if not folder.is_dir():
+        raise ValueError(f"`path` must be in an existing folder, got {str(path)!r}: the folder {str(folder)!r} "
+                         + ("is a file." if folder.exists() else "does not exist (create it first)."))
+    if path.is_dir():
+        raise ValueError(f"`path` must name a file, got {str(path)!r}, which is a folder.")
+    if not os.access(folder, os.W_OK):
+        raise ValueError(f"`path` must be in a writable folder, got {str(path)!r}.")
     ds = to_dataset(fields)
-    # Strings as variable-length UTF-8; floats stored uncompressed so they come back bit for bit.
-    ds.to_netcdf(path, engine=engine, format="NETCDF4")
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        # Strings as variable-length UTF-8; floats uncompressed (bit for bit) with Fletcher-32 checksums.
+        ds.to_netcdf(tmp, engine=engine, format="NETCDF4", encoding=_filecheck.encoding(ds))
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
     return path
 
 
@@ -213,6 +249,25 @@ def _loads(ds, key, path):
         raise ResultFileError(f"{path}: damaged ancfdae result file: attribute {key!r} is missing.") from None
     except (TypeError, ValueError) as exc:
         raise ResultFileError(f"{path}: damaged ancfdae result file: attribute {key!r} is not JSON ({exc}).") from None
+
+
+def _check_dimensions(ds, arrays, model, path):
+    """Raise ResultFileError when the arrays' dimensions disagree with each other or the beam description."""
+    shape = arrays["q"].shape
+    for name in ("v", "a"):
+        if arrays[name].shape != shape:
+            raise ResultFileError(f"{path}: damaged ancfdae result file: variable {name!r} has shape "
+                                  f"{arrays[name].shape}, variable 'q' {shape}.")
+    n_dof = model.get("n_dof") if isinstance(model, dict) else None
+    if n_dof is not None and len(shape) == 2 and shape[1] != n_dof:
+        raise ResultFileError(f"{path}: damaged ancfdae result file: variable 'q' has {shape[1]} coordinates "
+                              f"per output (dimension 'dof'), the stored beam description n_dof = {n_dof}.")
+    for var, key in (("reference_nodes", "nodes"), ("element_nodes", "element_nodes")):
+        if var in ds.variables and isinstance(model, dict) and key in model:
+            want = np.shape(model[key])
+            if ds[var].shape != want:
+                raise ResultFileError(f"{path}: damaged ancfdae result file: variable {var!r} has shape "
+                                      f"{ds[var].shape}, the stored beam description {want}.")
 
 
 def from_dataset(ds, path="<dataset>") -> dict:
@@ -235,7 +290,7 @@ def from_dataset(ds, path="<dataset>") -> dict:
     ResultFileError
         If a variable or attribute is missing or malformed.
     """
-    if ds.attrs.get("format") != FORMAT:
+    if ds.attrs.get("format") not in (FORMAT, *_LEGACY):
         raise ResultFileError(f"{path}: not an ancfdae result file (attribute 'format' is "
                               f"{ds.attrs.get('format')!r}, expected {FORMAT!r}).")
     t = _require(ds, "time", path)
@@ -249,6 +304,7 @@ def from_dataset(ds, path="<dataset>") -> dict:
         elif "state" in attrs:
             state[str(attrs["state"])] = ds[name].values
     model = _loads(ds, "model", path)
+    _check_dimensions(ds, arrays, model, path)
     if model and "node" in ds.coords:
         model["dof_labels"] = {"node": ds["node"].values.tolist(), "coordinate": ds["coordinate"].values.tolist()}
     t_fail = float(ds.attrs.get("t_fail", math.nan))
@@ -280,11 +336,28 @@ def read(path) -> dict:
     if magic != b"\x89HDF\r\n\x1a\n":
         raise ResultFileError(f"{path}: not a NetCDF4/HDF5 file (it does not start with the HDF5 signature).")
     try:
-        with xr.open_dataset(path, engine=ENGINE) as ds:
-            ds.load()
-            return from_dataset(ds, path)
-    except ResultFileError:
-        raise
-    except Exception as exc:   # h5py/h5netcdf raise OSError, KeyError, ValueError... on damaged files
+        ds = xr.open_dataset(path, engine=ENGINE)
+    except Exception as exc:   # the HDF5 library raises OSError, KeyError, ValueError... on damaged files
         raise ResultFileError(f"{path}: damaged or truncated NetCDF4/HDF5 file ({type(exc).__name__}: {exc}).") \
             from exc
+    with ds:
+        for name in list(ds.variables):
+            try:
+                ds.variables[name].load()      # the HDF5 library verifies Fletcher-32 here
+            except Exception as exc:  # noqa: BLE001 - any failure to read a variable is damage
+                raise ResultFileError(f"{path}: damaged ancfdae result file: variable {name!r} cannot be read "
+                                      f"(its data fail their checksum or are truncated: {type(exc).__name__}: "
+                                      f"{exc}).") from exc
+        if _filecheck.CHECKSUM_ATTR in ds.attrs or ds.attrs.get("format") == FORMAT:
+            problem = _filecheck.verify(ds, path)
+            if problem:
+                raise ResultFileError(f"{path}: damaged ancfdae result file: {problem}.")
+        elif any(var.encoding.get("fletcher32") for var in ds.variables.values()):
+            raise ResultFileError(f"{path}: damaged ancfdae result file: its variables carry the checksums of "
+                                  f"format {FORMAT!r} but the attribute {_filecheck.CHECKSUM_ATTR!r} is missing.")
+        try:
+            return from_dataset(ds, path)
+        except ResultFileError:
+            raise
+        except Exception as exc:  # noqa: BLE001 - malformed content that passed the checks (a format-2 file)
+            raise ResultFileError(f"{path}: damaged ancfdae result file ({type(exc).__name__}: {exc}).") from exc

@@ -59,18 +59,27 @@ def _load_result(path: str):
 
 
 def _positive(text: str) -> int:
-    value = int(text)
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a positive integer, got {text!r}") from None
     if value < 1:
         raise argparse.ArgumentTypeError(f"must be a positive integer, got {value}")
     return value
+
+
+def _user_error(what: str, exc: Exception):
+    """The one line for a user's error (a bad path, a result without a beam): no traceback."""
+    text = str(exc) if isinstance(exc, ValueError) else f"{type(exc).__name__}: {exc}"
+    return SystemExit(f"ancfdae {what}: {text}")
 
 
 def _export(args) -> int:
     result = _load_result(args.result)
     try:
         pvd = vtk(result, None, args.directory, name=args.name, every=args.every)
-    except ValueError as exc:
-        raise SystemExit(f"ancfdae: {args.result}: {exc}") from None
+    except (ValueError, OSError) as exc:      # the arguments are named by the message (`directory`, `name`)
+        raise _user_error("export vtk", exc) from None
     print(f"ParaView time series written to {pvd}")
     return 0
 
@@ -79,8 +88,8 @@ def _animate(args) -> int:
     result = _load_result(args.result)
     try:
         out = animate(result, args.output, every=args.every, fps=args.fps)
-    except ValueError as exc:
-        raise SystemExit(f"ancfdae: {args.result}: {exc}") from None
+    except (ValueError, OSError) as exc:      # `path` is the OUTPUT argument
+        raise _user_error("animate", exc) from None
     print(f"animation written to {out}")
     return 0
 
@@ -96,7 +105,8 @@ def main(argv: list[str] | None = None) -> int:
     Returns
     -------
     int
-        Exit status 0; errors exit through :class:`SystemExit` with a message.
+        Exit status: 0, or a study's (1 when one of its cases failed); a user's error exits
+        through :class:`SystemExit` with a one-line message (status 1, 2 for a usage error).
     """
     parser = argparse.ArgumentParser(prog="ancfdae", description="ANCF beam dynamics: studies, result files, "
                                      "ParaView export and animations.")
@@ -116,7 +126,7 @@ def main(argv: list[str] | None = None) -> int:
     vt.add_argument("--every", type=_positive, default=1, help="write every N-th output (default 1)")
     an = sub.add_parser("animate", help="write an animated GIF of a result file")
     an.add_argument("result", help="result file written by Result.save (.nc)")
-    an.add_argument("output", help="the .gif file to write")
+    an.add_argument("output", help="the .gif file to write (its folder must exist; an existing file is replaced)")
     an.add_argument("--every", type=_positive, default=1, help="draw every N-th output (default 1)")
     an.add_argument("--fps", type=_positive, default=20, help="frames per second (default 20)")
     args = parser.parse_args(argv)

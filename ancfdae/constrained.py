@@ -25,6 +25,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ancfdae.kkt import KKTAssembler
+
 __all__ = ["kkt_matrix", "multipliers", "project_positions", "project_velocities", "consistent_state",
            "dependent_rows", "constraint_power", "ConsistentState", "PROJECTION_LIMIT"]
 
@@ -35,12 +37,10 @@ _log = logging.getLogger("ancfdae")
 PROJECTION_LIMIT = 1e-3
 
 
-def kkt_matrix(M, G, upper_left=None) -> sp.csc_matrix:
-    """``[[M (+ upper_left), G^T], [G, 0]]`` as CSC (for SuperLU)."""
-    A = sp.csr_matrix(M) if upper_left is None else sp.csr_matrix(M + upper_left)
-    G = sp.csr_matrix(G)
-    m = G.shape[0]
-    return sp.bmat([[A, G.T], [G, sp.csr_matrix((m, m))]], format="csc")
+def kkt_matrix(M, G, upper_left=None, assembler: KKTAssembler | None = None) -> sp.csc_matrix:
+    """``[[M (+ upper_left), G^T], [G, 0]]`` as CSC (for SuperLU); ``assembler`` reuses its fixed pattern."""
+    blocks = [M] if upper_left is None else [M, upper_left]
+    return (assembler or KKTAssembler()).assemble(blocks, G, 1.0, G, 1.0).tocsc()
 
 
 def _solve(K, rhs, what):
@@ -54,7 +54,8 @@ def _solve(K, rhs, what):
     return x
 
 
-def multipliers(model, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def multipliers(model, t: float, q: np.ndarray, v: np.ndarray, *,
+                assembler: KKTAssembler | None = None) -> tuple[np.ndarray, np.ndarray]:
     """``(a, lam)`` consistent with ``(t, q, v)``: ``M a + r(t, q, v, 0) + G^T lam = 0``, ``G a = gamma``.
 
     Parameters
@@ -62,6 +63,8 @@ def multipliers(model, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarr
     model : Model with the ``"constraints"`` capability
     t : float
     q, v : ndarray, shape (n,)
+    assembler : KKTAssembler, optional
+        Reused across calls (the KKT pattern is found once); a run's recorder keeps one.
 
     Returns
     -------
@@ -71,7 +74,8 @@ def multipliers(model, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarr
     n = q.size
     r0 = np.asarray(model.residual(t, q, v, np.zeros(n)), dtype=float)
     _, gamma = model.constraint_rates(t, q, v)
-    x = _solve(kkt_matrix(model.mass(q), model.constraint_jacobian(t, q)), np.concatenate([-r0, gamma]),
+    x = _solve(kkt_matrix(model.mass(q), model.constraint_jacobian(t, q), assembler=assembler),
+               np.concatenate([-r0, gamma]),
                f"multipliers at t = {t:g}")
     return x[:n], x[n:]
 

@@ -53,6 +53,9 @@ def constant(value: float = 1.0) -> TimeFunction:
     callable
         ``time(t) -> float``.
     """
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not np.isfinite(value):
+        raise ValueError(f"`value` must be a finite real number, got {value!r}.")
+    value = float(value)
     return lambda t: value
 
 

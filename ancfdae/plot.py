@@ -17,12 +17,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from . import _validate as validate
 from ._sections import output_directors, section_outline, section_vectors
-from .export import beam_of
+from .export import bodies_of, beam_of
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
+    from .bodies import RigidBody
     from .models import Beam
     from .result import Result
 
@@ -39,6 +41,10 @@ def _new_axes(three_d: bool):
     return fig.add_subplot(projection="3d" if three_d else None)
 
 
+def _dim(body) -> int:
+    return body.dim if _is_rigid(body) else body.element.dim
+
+
 def _check_q(beam, q):
     q = np.asarray(q, dtype=float)
     if q.shape != (beam.n_dof,):
@@ -46,13 +52,14 @@ def _check_q(beam, q):
     return q
 
 
-def configuration(beam: Beam, q: ArrayLike, ax: Axes | None = None, *, directors: np.ndarray | None = None,
-                  sections: bool = True, color: Any = None) -> Axes:
-    """Draw a configuration of a beam: its axis and the outline of the solid.
+def configuration(beam: Beam | RigidBody, q: ArrayLike, ax: Axes | None = None, *,
+                  directors: np.ndarray | None = None, sections: bool = True, color: Any = None) -> Axes:
+    """Draw a configuration of a beam (its axis and the outline of the solid) or of a rigid body (the edges
+    of the box of its inertia, :func:`ancfdae.bodies.picture.box_corners`).
 
     Parameters
     ----------
-    beam : Beam
+    beam : Beam or RigidBody
     q : array_like, shape (n_dof,)
         Free coordinates, e.g. ``result.q[i]``.
     ax : matplotlib Axes, optional
@@ -72,6 +79,8 @@ def configuration(beam: Beam, q: ArrayLike, ax: Axes | None = None, *, directors
         The first line drawn is the axis, sampled at ``8`` points per element.
     """
     q = _check_q(beam, q)
+    if _is_rigid(beam):
+        return _rigid_configuration(beam, q, ax, color)
     dim = beam.element.dim
     if ax is None:
         ax = _new_axes(dim == 3)
@@ -108,6 +117,28 @@ def configuration(beam: Beam, q: ArrayLike, ax: Axes | None = None, *, directors
     ax.set_ylabel("y")
     if dim == 3:
         ax.set_zlabel("z")
+    return ax
+
+
+def _is_rigid(body) -> bool:
+    from .bodies import RigidBody
+    return isinstance(body, RigidBody)
+
+
+def _rigid_configuration(body: RigidBody, q: np.ndarray, ax: Axes | None, color: Any) -> Axes:
+    """A rigid body as the edges of the box of its inertia, the first line drawn from the centre of mass."""
+    from .bodies.picture import box_edges, box_points
+    if ax is None:
+        ax = _new_axes(body.dim == 3)
+    elif (body.dim == 3) != hasattr(ax, "zaxis"):
+        raise ValueError(f"`ax` must be {'a 3D' if body.dim == 3 else 'a 2D'} axes for a {body.dim}D rigid body, "
+                         f"got {type(ax).__name__}.")
+    corners = box_points(body, q)
+    (line,) = ax.plot(*np.array([body.centre_of_mass(q)] * 2).T, "o", color=color, ms=3, label="centre of mass")
+    for a, b in box_edges(body.dim):
+        ax.plot(*corners[[a, b]].T, color=line.get_color(), lw=1.2)
+    if body.dim == 2:
+        ax.set_aspect("equal", adjustable="datalim")
     return ax
 
 
@@ -175,16 +206,18 @@ def tip(result: Result, ax: Axes | None = None, *, beam: Beam | None = None, s: 
     return ax
 
 
-def animate(result: Result, path: str | os.PathLike, *, beam: Beam | None = None, every: int = 1, fps: int = 20, dpi: int = 80) -> Path:
-    """Write an animated GIF of the beam's motion.
+def animate(result: Result, path: str | os.PathLike, *, beam: Beam | RigidBody | None = None, every: int = 1,
+            fps: int = 20, dpi: int = 80) -> Path:
+    """Write an animated GIF of the motion of a beam, a rigid body or a system of bodies.
 
     Parameters
     ----------
     result : Result
     path : str or path-like
         The ``.gif`` file to write.
-    beam : Beam, optional
-        Default: rebuilt from the description in ``result``.
+    beam : Beam or RigidBody, optional
+        Default: rebuilt from the description in ``result`` (a system's bodies too, as
+        :func:`ancfdae.export.vtk` reads them).
     every : int
         Draw every ``every``-th output.
     fps : int
@@ -201,30 +234,39 @@ def animate(result: Result, path: str | os.PathLike, *, beam: Beam | None = None
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    if beam is None:
-        beam = beam_of(result)
     if isinstance(every, bool) or not isinstance(every, int) or every < 1:
         raise ValueError(f"`every` must be a positive integer, got {every!r}.")
     if result.t.size == 0:
         raise ValueError("`result` has no outputs to animate.")
-    path = Path(path)
-    directors = output_directors(result, beam)
+    fps = validate.positive_int("fps", fps)
+    dpi = validate.positive_int("dpi", dpi)
+    path = validate.output_file("path", path, (".gif",))
+    parts = bodies_of(result, beam)
     frames = range(0, result.t.size, every)
     fig = Figure(figsize=(6, 4))
     FigureCanvasAgg(fig)     # off-screen rendering, whatever backend pyplot uses
-    three_d = beam.element.dim == 3
+    three_d = _dim(parts[0][0]) == 3
     ax = fig.add_subplot(projection="3d" if three_d else None)
-    # Fixed limits: the extent of the drawn solid over all frames.
-    pts = np.concatenate([section_vectors(beam, result.q[i], None if directors is None else directors[i])[0]
-                          for i in frames])
-    pad = 0.6 * max(getattr(beam.element.section, "h", 0.0), getattr(beam.element.section, "d", 0.0),
-                    np.sqrt(beam.element.section.A))
+    directors = [output_directors(result, b) if len(parts) == 1 and not _is_rigid(b) else None for b, _ in parts]
+    # Fixed limits: the extent of the drawn bodies over all frames.
+    pts, pad = [], 0.0
+    for (body, cols), d in zip(parts, directors):
+        if _is_rigid(body):
+            from .bodies.picture import box_points
+            pts.append(box_points(body, result.q[list(frames)][:, cols]).reshape(-1, body.dim))
+            continue
+        pts += [section_vectors(body, result.q[i, cols], None if d is None else d[i])[0][:, :_dim(body)]
+                for i in frames]
+        sec = body.element.section
+        pad = max(pad, 0.6 * max(getattr(sec, "h", 0.0), getattr(sec, "d", 0.0), np.sqrt(sec.A)))
+    pts = np.concatenate(pts)
     lo, hi = pts.min(axis=0) - pad, pts.max(axis=0) + pad
     writer = PillowWriter(fps=fps)
     with writer.saving(fig, str(path), dpi=dpi):
         for i in frames:
             ax.clear()
-            configuration(beam, result.q[i], ax, directors=None if directors is None else directors[i])
+            for (body, cols), d in zip(parts, directors):
+                configuration(body, result.q[i, cols], ax, directors=None if d is None else d[i])
             if not three_d:
                 ax.set_aspect("equal", adjustable="box")
             ax.set_xlim(lo[0], hi[0])

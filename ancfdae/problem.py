@@ -140,6 +140,10 @@ class Model(Protocol):
 #:     stages of a Runge-Kutta step in one call (Lobatto IIIA).
 #: ``"variable_mass"``
 #:     ``M`` depends on ``q`` (then ``mass_is_constant`` must be False); no extra method.
+#: ``"mass_forms"``
+#:     with ``"variable_mass"``: ``mass_action(q, x, tangent) -> (M(q) x, d(M x)/dq or None)`` and
+#:     ``mass_bilinear(q, u, w, order) -> (B, dB/dq, d2B/dq2)`` of ``B = u^T M(q) w / 2`` (the
+#:     energy-momentum integrator's discrete gradient of a configuration-dependent kinetic energy).
 #: ``"step_events"``
 #:     the model has an *event state* (a dict of arrays, e.g. BE3D's nodal directors) that may change
 #:     between steps: ``event_state() -> dict`` (the initial state), ``bind(state) -> Model`` (a model
@@ -168,6 +172,7 @@ CAPABILITIES: dict[str, tuple[str, ...]] = {
     "residual_jacobian": ("residual_jacobian",),
     "residual_stages": ("residual_stages",),
     "variable_mass": (),
+    "mass_forms": ("mass_action", "mass_bilinear"),
     "step_events": ("event_state", "bind", "step_event"),
     "potential": ("potential", "potential_gradient", "nonconservative_force"),
     "constraints": ("constraints", "constraint_jacobian", "constraint_force_jacobian", "constraint_rates"),
@@ -282,6 +287,14 @@ class ConstrainedModel(Protocol):
     ----------
     n_constraints : int
         ``m``, the number of rows of ``g``.
+
+    Notes
+    -----
+    Optional, used when present: ``constraint_force(t, q, lam) -> G^T lam`` (without forming ``G``; the
+    steppers' residuals need it at every Newton iteration), ``constraint_velocity_jacobian(t, q, v) ->
+    d(G v + g_t)/dq`` (index-2 formulations), ``constraint_degree`` (1 or 2 when every row is at most
+    quadratic in ``q`` with time only in its linear part; the energy-momentum method requires it) and
+    ``constraint_labels`` (one name per row, for messages and results).
     """
 
     n_constraints: int

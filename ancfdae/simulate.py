@@ -18,6 +18,7 @@ from typing import Any
 from numpy.typing import ArrayLike
 
 from ancfdae.integrators.driver import integrate
+from ancfdae.integrators.energy_collocation import EnergyCollocation
 from ancfdae.integrators.energy_momentum import EnergyMomentum
 from ancfdae.integrators.ida import IDA
 from ancfdae.integrators.integrator import Integrator
@@ -39,6 +40,7 @@ METHODS = {
     "generalized-alpha": GeneralizedAlpha,
     "ida": IDA,
     "energy-momentum": EnergyMomentum,
+    "energy-collocation": EnergyCollocation,
 }
 
 
@@ -98,7 +100,8 @@ def simulate(model: Model, t_span: tuple[float, float], method: str | type[Integ
         Lobatto IIIA, order 4), ``"lobatto2"``, ``"newmark"``, ``"hht"``,
         ``"generalized-alpha"``, ``"ida"``, ``"energy-momentum"`` (constant
         mass matrix and the ``"potential"`` capability: energy and momenta
-        kept exactly) -- or a class written against
+        kept exactly, order 2), ``"energy-collocation"`` (the same models:
+        energy kept exactly, order 4) -- or a class written against
         :class:`ancfdae.integrators.Integrator` (built with
         ``cls(model, h, **options)`` or ``cls(model, **options)``), or a
         constructed instance (then no ``h`` or options here).

@@ -1,6 +1,8 @@
 """Static equilibrium by Newton's method with uniform load steps (chapter Sect. 5.1)."""
 from __future__ import annotations
 
+import logging
+import numbers
 import time as _time
 import warnings
 from dataclasses import dataclass, field
@@ -9,6 +11,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.linalg import LinAlgWarning
 
+from . import _static_checks
 from . import _validate as validate
 from ._scale import absolute_tolerance
 from .integrators._newton import NewtonSolver
@@ -16,6 +19,8 @@ from .integrators._newton_records import RENAMED_ATOL, NewtonOptions
 from .problem import Model, capabilities
 
 __all__ = ["solve_static", "StaticResult"]
+
+_log = logging.getLogger("ancfdae")
 
 
 @dataclass
@@ -42,6 +47,16 @@ class StaticResult:
     state : dict
         The model's event state after the last converged load step (models with the
         ``"step_events"`` capability, e.g. BE3D's ``{"directors": ...}``); empty otherwise.
+    negative_eigenvalues : int or None
+        Negative eigenvalues of the (symmetric part of the) tangent stiffness at ``q``, counted by
+        the inertia of its ``L D L^T`` factorisation (:func:`ancfdae._static_checks.inertia`);
+        None when not determined (``check_stability=False``, or no load step converged).
+    zero_eigenvalues : int or None
+        Eigenvalues within round-off of zero (a neutral direction), likewise.
+    warnings : list of str
+        What is implausible about ``q`` (axial strain beyond the elements' range, a folded
+        element; :func:`ancfdae._static_checks.plausibility`) or unstable about it; each is also
+        logged as a warning on the ``"ancfdae"`` logger.
     """
 
     q: np.ndarray
@@ -51,16 +66,28 @@ class StaticResult:
     steps: list = field(default_factory=list)
     stats: dict = field(default_factory=dict)
     state: dict = field(default_factory=dict)
+    negative_eigenvalues: int | None = None
+    zero_eigenvalues: int | None = None
+    warnings: list = field(default_factory=list)
 
     @property
     def success(self) -> bool:
         """True when every load step converged."""
         return self.status == "success"
 
+    @property
+    def stable(self) -> bool | None:
+        """True when the tangent at ``q`` is positive definite (a stable equilibrium, for conservative
+        loads); False when it has a negative or zero eigenvalue; None when not determined."""
+        if self.negative_eigenvalues is None:
+            return None
+        return self.negative_eigenvalues == 0 and self.zero_eigenvalues == 0
+
 
 @validate.renamed("atol", "residual_atol", RENAMED_ATOL)
 def solve_static(model: Model, load_steps: int = 10, *, t: float = 0.0, q0: ArrayLike | None = None, tol: float = 1e-8,
-                 residual_atol: float | None = None, max_iter: int = 25, jacobian: str = "full") -> StaticResult:
+                 residual_atol: float | None = None, max_iter: int = 25, jacobian: str = "full",
+                 check_stability: bool = True, max_strain: float | None = _static_checks.MAX_STRAIN) -> StaticResult:
     """Solve ``r(t, q, 0, 0) = 0`` with the loads applied in uniform steps.
 
     Load step ``i`` solves for the load factor ``lambda_i = i / load_steps``,
@@ -94,13 +121,30 @@ def solve_static(model: Model, load_steps: int = 10, *, t: float = 0.0, q0: Arra
     jacobian : {"full", "modified"}
         Newton's refresh policy (:class:`ancfdae.integrators.NewtonOptions`);
         ``"full"`` is the chapter's classical Newton.
+    check_stability : bool
+        Count the negative eigenvalues of the tangent at the solution (one sparse ``L D L^T``
+        factorisation). Newton converges to any equilibrium near its start, e.g. a cantilever
+        held by a pin only pointing against its tip force; such an unstable equilibrium is
+        reported in ``negative_eigenvalues``, ``stable`` and ``warnings`` and logged.
+    max_strain : float or None
+        Axial strain above which the solution is flagged as beyond the elements' range
+        (default 0.1: the Green strain with St. Venant-Kirchhoff's law is meant for small
+        strains); folded elements are flagged too. None skips the check.
 
     Returns
     -------
     StaticResult
         A step that does not converge ends the solve with ``status="failed"``
         and a message naming the load step and its residual; ``q`` is then the
-        last converged step's solution.
+        last converged step's solution. A converged solution that is unstable or
+        implausible keeps ``status="success"`` and says so in ``warnings``.
+
+    Raises
+    ------
+    ValueError
+        For bad arguments, naming the argument: a non-finite or wrong-length ``q0``
+        (also the model's initial state), a non-finite ``t``, or loads whose residual at
+        ``q0`` is not finite.
     """
     load_steps = validate.positive_int("load_steps", load_steps)
     if load_steps > 1 and not hasattr(model, "load_factor"):
@@ -109,9 +153,22 @@ def solve_static(model: Model, load_steps: int = 10, *, t: float = 0.0, q0: Arra
     caps = capabilities(model)
     state = model.event_state() if "step_events" in caps else {}
     m = model.bind(state) if state else model   # the model is never changed; the state is carried here
-    q = model.initial_state()[0].copy() if q0 is None else np.array(q0, dtype=float)
-    if q.shape != (model.n_dof,):
-        raise ValueError(f"`q0` must have shape ({model.n_dof},), got {q.shape}.")
+    if isinstance(t, bool) or not isinstance(t, numbers.Real) or not np.isfinite(t):
+        raise ValueError(f"`t` must be a finite real number (the time at which the loads are evaluated), got {t!r}.")
+    t = float(t)
+    if q0 is None:
+        q = validate.finite_vector("q0 (the model's initial state, used as q0 was not given)",
+                                   model.initial_state()[0], model.n_dof).copy()
+    else:
+        q = validate.finite_vector("q0", q0, model.n_dof).copy()
+    check_stability = validate.flag("check_stability", check_stability)
+    if max_strain is not None:
+        max_strain = validate.positive("max_strain", max_strain)
+    z0 = np.zeros(model.n_dof)
+    r0 = np.asarray(m.residual(t, q, z0, z0), dtype=float)
+    if not np.all(np.isfinite(r0)):
+        raise ValueError(f"the residual at `q0` (t = {t:g}) is not finite: a load (or its time function) or the "
+                         "model returns NaN or inf there; check the loads' values and time functions.")
     if residual_atol is None:
         residual_atol = absolute_tolerance(model, t, q)
     solver = NewtonSolver(NewtonOptions(tol=tol, residual_atol=residual_atol, max_iter=max_iter, jacobian=jacobian))
@@ -160,5 +217,30 @@ def solve_static(model: Model, load_steps: int = 10, *, t: float = 0.0, q0: Arra
             model.load_factor = saved
     stats = solver.stats.as_stats()
     stats["cpu_time"] = _time.process_time() - start
-    return StaticResult(q=q, status=status, message=message,
-                        iterations=sum(s["iterations"] for s in steps), steps=steps, stats=stats, state=state)
+    result = StaticResult(q=q, status=status, message=message,
+                          iterations=sum(s["iterations"] for s in steps), steps=steps, stats=stats, state=state)
+    if any(s["converged"] for s in steps):
+        _judge(result, m, t, check_stability, max_strain, len([s for s in steps if s["converged"]]), load_steps)
+    return result
+
+
+def _judge(result, m, t, check_stability, max_strain, done, load_steps):
+    """Fill ``result``'s stability and plausibility of the last converged load step; log what is wrong."""
+    where = "the solution" if done == load_steps else f"the last converged load step ({done} of {load_steps})"
+    if check_stability and done == load_steps:      # the tangent at the full load, where q is the solution
+        z = np.zeros_like(result.q)
+        n_neg, n_zero, how = _static_checks.inertia(m.jacobian(t, result.q, z, z).K)
+        result.negative_eigenvalues, result.zero_eigenvalues = n_neg, n_zero
+        if n_neg:
+            result.warnings.append(f"{where} is an unstable equilibrium: the tangent stiffness has {n_neg} "
+                                   f"negative eigenvalue(s) ({how}); a small disturbance leaves it (e.g. a "
+                                   "beam held by a pin pointing against its load); start from another q0")
+        elif n_zero:
+            result.warnings.append(f"{where} is not a stable equilibrium: the tangent stiffness has {n_zero} "
+                                   f"zero eigenvalue(s) ({how}), a neutral direction")
+        elif n_neg is None:
+            result.warnings.append(f"the stability of {where} was {how}")
+    if max_strain is not None:
+        result.warnings += [f"{where}: {w}" for w in _static_checks.plausibility(m, result.q, max_strain)]
+    for w in result.warnings:
+        _log.warning("solve_static: %s", w)

@@ -114,15 +114,26 @@ class System(BodyStack):
     def _stack_rows(self, blocks, joint_part):
         if not blocks:
             return joint_part
-        n = self.n_dof
-        shifted = [sp.csr_matrix((sp.csr_matrix(B).data, sp.csr_matrix(B).indices + o, sp.csr_matrix(B).indptr),
-                                 shape=(B.shape[0], n)) for B, o in blocks]
+        n, shifted = self.n_dof, []
+        for B, o in blocks:
+            B = sp.csr_matrix(B)
+            shifted.append(sp.csr_matrix((B.data, B.indices + o, B.indptr), shape=(B.shape[0], n)))
         return sp.vstack(shifted + [joint_part], format="csr")
 
     def constraint_jacobian(self, t: float, q: np.ndarray) -> sp.csr_matrix:
         """``G = dg/dq`` on a fixed pattern, shape (n_constraints, n_dof)."""
         blocks = [(b.constraint_jacobian(t, q[o:o + b.n_dof]), o) for b, o, _ in self._body_rows]
         return self._stack_rows(blocks, self._joint_set.G(t, q))
+
+    def constraint_force(self, t: float, q: np.ndarray, lam: np.ndarray) -> np.ndarray:
+        """``G(t, q)^T lam`` without forming ``G`` (optional fast path of the capability)."""
+        mb = self.n_constraints - self._joint_set.m
+        f = self._joint_set.force(t, q, lam[mb:])
+        r = 0
+        for b, o, m in self._body_rows:
+            f[o:o + b.n_dof] += b.constraint_jacobian(t, q[o:o + b.n_dof]).T @ lam[r:r + m]
+            r += m
+        return f
 
     def constraint_force_jacobian(self, t: float, q: np.ndarray, lam: np.ndarray) -> sp.csr_matrix:
         """``d(G^T lam)/dq``, shape (n_dof, n_dof); constant in ``q`` (every joint is at most quadratic)."""

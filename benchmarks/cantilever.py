@@ -44,7 +44,7 @@ LADDER = ("ours", "exudyn", 1e-7, 1e-6, 1e-5, 1e-4)
 
 def _ours_once(beam, name):
     c0, t0 = time.process_time(), time.perf_counter()
-    res = solve_static(beam, load_steps=10, tol=1e-8)
+    res = solve_static(beam, load_steps=10, tol=1e-8, check_stability=False, max_strain=None)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     tip = beam.position(res.q, 2.0)[:2] - [2.0, 0.0]
     fam = "SQ" if name.startswith("SQ") else "BE"

@@ -53,9 +53,12 @@ def parser(module, prog: str | None = None) -> argparse.ArgumentParser:
     p.add_argument("--out", default=None,
                    help=f"output folder; a rerun with the same folder reuses its finished cases "
                         f"(default: out/{name}, with --quick out/{name}-quick)")
-    if "jobs" in inspect.signature(module.run).parameters:
+    if _takes_jobs(module):
         p.add_argument("--jobs", type=int, default=None,
                        help="worker processes for the sweep (default: 1, serial, timings undisturbed)")
+    else:       # accepted as 1 so that the common synopsis holds; more is refused with the reason
+        p.add_argument("--jobs", type=int, default=None,
+                       help="only 1: this study runs its cases serially (its CPU times are its result)")
     full, quick = getattr(module, "FULL", {}), getattr(module, "QUICK", {})
     for opt in getattr(module, "CLI_OPTIONS", ()):
         default = f"default: {_fmt(full.get(opt.name))}"
@@ -66,16 +69,29 @@ def parser(module, prog: str | None = None) -> argparse.ArgumentParser:
     return p
 
 
+def _takes_jobs(module) -> bool:
+    return "jobs" in inspect.signature(module.run).parameters
+
+
 def _terminate(signum, frame):
     raise KeyboardInterrupt
 
 
 def main(module, argv=None, prog: str | None = None) -> int:
-    """Parse ``argv``, run the study, print its table; return the exit status (130 after Ctrl-C)."""
+    """Parse ``argv``, run the study, print its table; return the exit status.
+
+    0 when every case finished, 1 when a case failed (the others are kept and shown), 2 for a bad
+    option (said before any work), 130 after Ctrl-C.
+    """
     p = parser(module, prog)
     args = vars(p.parse_args(argv))
     if args.get("jobs") is not None and args["jobs"] < 1:
         p.error(f"--jobs must be a positive integer, got {args['jobs']}")
+    if not _takes_jobs(module):
+        if args.get("jobs") not in (None, 1):
+            p.error(f"--jobs must be 1 for this study, got {args['jobs']}: it runs its cases serially because their "
+                    "CPU times are its result (the other studies take --jobs N)")
+        args.pop("jobs", None)
     options = {k: v for k, v in args.items() if v is not None and k not in ("quick",)}
     previous = None
     if threading.current_thread() is threading.main_thread():
@@ -90,7 +106,8 @@ def main(module, argv=None, prog: str | None = None) -> int:
         print(f"{p.prog} interrupted.", file=sys.stderr)
         return 130
     except OptionError as exc:          # bad options (e.g. --out an existing file): said at once, before any work
-        p.error(str(exc))
+        print(f"{p.prog}: error: {exc}", file=sys.stderr)     # one line (`--help` shows the options)
+        return 2
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
@@ -98,4 +115,9 @@ def main(module, argv=None, prog: str | None = None) -> int:
         print(result["table"])
     if result.get("path") is not None:
         print(f"results written to {result['path']}")
+    errors = result.get("errors") or {}
+    if errors:        # the finished cases are kept and shown; the command still says it did not all work
+        print(f"{p.prog}: {len(errors)} case(s) failed: {', '.join(errors)} (the reasons are in the table's notes); "
+              "exit status 1", file=sys.stderr)
+        return 1
     return 0

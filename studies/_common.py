@@ -36,10 +36,10 @@ folder or None). The command line (:mod:`ancfdae.studies._cli`) maps
 """
 from __future__ import annotations
 
-import json
+import math
 import multiprocessing
+import numbers
 import os
-import re
 import signal
 import sys
 import time
@@ -48,7 +48,7 @@ from concurrent.futures import FIRST_COMPLETED, Executor, ProcessPoolExecutor, w
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ancfdae.result import Result
+from ._store import CaseStore
 
 __all__ = ["Case", "OptionError", "output_dir", "CaseStore", "Sweep", "Interrupted", "run_cases", "progress_bar",
            "settings"]
@@ -92,78 +92,6 @@ class Case(dict):
 
     def __str__(self):
         return str(self.get("label", dict.__repr__(self)))
-
-
-def _jsonable(obj):
-    """Plain Python (lists, floats, ...) of ``obj`` for JSON; numpy scalars and arrays converted."""
-    if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    if hasattr(obj, "tolist"):
-        return obj.tolist()
-    return obj
-
-
-def _key(label: str) -> str:
-    """A file name from a case label ("BE2D 8 el (reference)" -> "BE2D_8_el_reference")."""
-    return re.sub(r"[^A-Za-z0-9.+-]+", "_", label).strip("_")
-
-
-class CaseStore:
-    """The finished cases of a study in ``folder/cases``.
-
-    Per case two files: the simulation's :class:`ancfdae.Result`, written by
-    :meth:`Result.save` (self-describing; its format is the library's), and
-    ``KEY.json`` with the case's options, its scalars (CPU time, counters, ...)
-    and the name of the Result file. The JSON is written last and atomically,
-    so a case counts as finished only once both files are complete. A case
-    whose function raised is kept as ``KEY.json`` with ``"error"``; it is run
-    again on the next run.
-    """
-
-    def __init__(self, folder):
-        self.folder = Path(folder) / "cases"
-        self.folder.mkdir(parents=True, exist_ok=True)
-
-    def _json(self, case) -> Path:
-        return self.folder / (_key(str(case)) + ".json")
-
-    def load(self, case):
-        """The stored record of ``case`` (a dict with ``"result"``), or None if absent, failed or stale."""
-        path = self._json(case)
-        if not path.is_file():
-            return None
-        try:
-            meta = json.loads(path.read_text())
-        except (OSError, ValueError):
-            return None
-        if meta.get("case") != _jsonable(dict(case)) or "error" in meta:
-            return None        # other options (or a failure): run it again
-        try:
-            result = Result.load(self.folder / meta["file"])
-        except (OSError, ValueError, KeyError):
-            return None
-        return dict(meta["record"], result=result)
-
-    def save(self, case, record: dict) -> Path:
-        """Write ``record`` (``"result"``: a Result; other entries JSON-able scalars) of ``case``."""
-        stem = _key(str(case))
-        file = record["result"].save(self.folder / stem)
-        scalars = {k: v for k, v in record.items() if k != "result"}
-        return self._write(case, {"case": _jsonable(dict(case)), "file": Path(file).name,
-                                  "record": _jsonable(scalars)})
-
-    def save_error(self, case, error: str) -> Path:
-        """Record that ``case`` raised (``error``: the exception's text)."""
-        return self._write(case, {"case": _jsonable(dict(case)), "error": error})
-
-    def _write(self, case, meta) -> Path:
-        path = self._json(case)
-        tmp = path.with_name(path.name + ".tmp")
-        tmp.write_text(json.dumps(meta, indent=1, allow_nan=True))
-        os.replace(tmp, path)
-        return path
 
 
 class Interrupted(KeyboardInterrupt):
@@ -273,7 +201,7 @@ def run_cases(fn, cases, out=None, executor: Executor | None = None, jobs: int |
     labels = [str(c) for c in cases]
     if len(set(labels)) != len(labels):
         raise ValueError(f"`cases` must have unique labels, got duplicates in {labels}.")
-    store = CaseStore(out) if out is not None else None
+    store = CaseStore(out, fn) if out is not None else None
     reduce = reduce or (lambda r: r)
     records = [None] * len(cases)
     todo = []
@@ -284,6 +212,8 @@ def run_cases(fn, cases, out=None, executor: Executor | None = None, jobs: int |
         else:
             records[i] = reduce(rec)
     sweep = Sweep(records, reused=len(cases) - len(todo))
+    for note in store.notes if store is not None else ():
+        print(f"{name}: {note}", file=sys.stderr, flush=True)
     if sweep.reused and progress:
         print(f"{name}: reusing {sweep.reused} of {len(cases)} finished cases from {store.folder}",
               file=sys.stderr, flush=True)
@@ -366,13 +296,38 @@ def _stop(pool) -> None:
         p.join(timeout=max(0.0, deadline - time.monotonic()))
 
 
-def settings(full: dict, quick_defaults: dict, quick: bool, given: dict) -> dict:
+def _numbers(value):
+    """The numbers in an option value (a number, or a list/tuple of them); text and None give none."""
+    if isinstance(value, (list, tuple)):
+        return [x for v in value for x in _numbers(v)]
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        return []
+    return [value]
+
+
+def settings(full: dict, quick_defaults: dict, quick: bool, given: dict, zero_allowed=(), unchecked=()) -> dict:
     """A study's options: the full (or, with ``quick``, the quick) defaults overridden by ``given``.
 
-    ``given`` holds the ``run`` arguments; None means "the mode's default".
+    ``given`` holds the ``run`` arguments; None means "the mode's default". Every number of the
+    result (also inside lists) must be finite and positive -- sizes, times, steps, tolerances --,
+    or zero for the options in ``zero_allowed`` ("0: none"); options in ``unchecked`` are not
+    checked. Checked here, before any work, so that a bad option is one clear error.
+
+    Raises
+    ------
+    OptionError
+        Naming the option, the rule and the value.
     """
     base = dict(full, **quick_defaults) if quick else dict(full)
     unknown = [k for k in given if k not in base]
     if unknown:
         raise TypeError(f"unknown study options {unknown}; known: {sorted(base)}")
-    return {k: (given[k] if given.get(k) is not None else v) for k, v in base.items()}
+    out = {k: (given[k] if given.get(k) is not None else v) for k, v in base.items()}
+    for k, value in out.items():
+        if k in unchecked:
+            continue
+        for x in _numbers(value):
+            if not math.isfinite(x) or x < 0 or (x == 0 and k not in zero_allowed):
+                rule = "non-negative (0: none)" if k in zero_allowed else "positive"
+                raise OptionError(f"`{k}` (--{k.replace('_', '-')}) must be {rule} and finite, got {value!r}.")
+    return out

@@ -34,7 +34,7 @@ from ancfdae.simulate import simulate
 
 from ._common import Case
 
-__all__ = ["Case", "MATERIAL", "SECTION", "LENGTH", "T_PULSE", "T_HAT", "B2_FORCE", "B2_MOMENT", "B3_MOMENT", "FAMILY",
+__all__ = ["Case", "MATERIAL", "SECTION", "LENGTH", "T_PULSE", "T_HAT", "OWN_NEWTON", "B2_FORCE", "B2_MOMENT", "B3_MOMENT", "FAMILY",
            "available", "b2_beam", "b3_beam",
            "output_times", "simulate_case", "unpack", "eps_T", "regress_order", "steady_drift"]
 
@@ -43,6 +43,8 @@ SECTION = RectangularSection(0.05)
 LENGTH = 1.0
 T_PULSE = 2.5      # B2: end of the load pulse (s)
 T_HAT = 3.0        # B3: end of the moment hat (s)
+#: methods whose own Newton default (driven to round-off) the studies keep unless told otherwise
+OWN_NEWTON = ("energy-momentum", "energy-collocation")
 B2_FORCE = 0.24    # B2: peak force (N, global x), revision 2
 B2_MOMENT = 0.24   # B2: peak moment (N m, about +e_z), revision 2
 B3_MOMENT = (0.1, 0.05, 0.2)   # B3: peak moment (N m, global axes), revision 2
@@ -114,7 +116,7 @@ def output_times(t_end: float, dt_out: float) -> np.ndarray:
 
 def simulate_case(beam, t_end: float, method: str = "lobatto3", h: float | None = 1e-3, dt_out: float = 0.01,
                   newton: dict | None = None, energy: bool = True, stop_on_blowup: bool = False,
-                  **options) -> dict:
+                  monitors: tuple = (), **options) -> dict:
     """Integrate ``beam`` over ``[0, t_end]``; return the run's record.
 
     Parameters
@@ -128,12 +130,14 @@ def simulate_case(beam, t_end: float, method: str = "lobatto3", h: float | None 
         ``h`` keeps the samples on the step grid, without interpolation).
     newton : dict, optional
         :class:`NewtonOptions` fields; default modified Newton, tol 1e-8
-        (chapter Sect. 5.2). The energy-momentum method keeps its own default
-        (round-off tolerance: what makes it conserve energy) unless ``newton`` is given.
+        (chapter Sect. 5.2). The energy-conserving methods (:data:`OWN_NEWTON`) keep their own
+        default (round-off tolerance: what makes them conserve energy) unless ``newton`` is given.
     energy : bool
         Log the energy balance (costs a few external-power evaluations per step).
     stop_on_blowup : bool
         End the run when the energy monitor flags a blow-up (10 % drift).
+    monitors : tuple of Monitor
+        Logged beside the tip and the energy (e.g. :class:`ancfdae.DirectorGeometry`).
 
     Returns
     -------
@@ -144,10 +148,10 @@ def simulate_case(beam, t_end: float, method: str = "lobatto3", h: float | None 
         analyses use.
     """
     t_eval = output_times(t_end, dt_out)
-    monitors = [PointSensor(s=0.0, name="tip")]
+    monitors = [PointSensor(s=0.0, name="tip"), *monitors]
     if energy:
         monitors.append(EnergyMonitor(stop_on_blowup=stop_on_blowup))
-    if method != "ida" and not (method == "energy-momentum" and newton is None):
+    if method != "ida" and not (method in OWN_NEWTON and newton is None):
         options["newton"] = NewtonOptions(**({"tol": 1e-8, "jacobian": "modified"} | (newton or {})))
     c0, w0 = time.process_time(), time.perf_counter()
     res = simulate(beam, (0.0, t_end), method=method, h=h, t_eval=t_eval, monitors=monitors, **options)

@@ -13,7 +13,7 @@ import numpy as np
 
 __all__ = ["figure", "save", "style", "order_guide", "plot_flying2d", "plot_flying3d"]
 
-_COLOR = {"BE2D": "C0", "SQ2D": "C1", "BE3D": "C0", "SQ3D": "C1", "Cable3D": "C2"}
+_COLOR = {"BE2D": "C0", "SQ2D": "C1", "BE3D": "C0", "SQ3D": "C1", "Cable3D": "C2", "BE3DSR": "C3"}
 
 
 def figure(nrows: int = 1, ncols: int = 1, **kw):
@@ -110,7 +110,9 @@ def plot_flying2d(rows, refs, orders, fits, path) -> dict:
 
 
 def _label3d(r):
-    lab = f"{r['element']} {r['n']} el" + (f" ({r['director_update']})" if r["element"] == "BE3D" else "")
+    thin = r["element"] in ("BE3D", "BE3DSR")
+    lab = f"{r['element']} {r['n']} el" + (f" ({r['director_update']})" if thin else "")
+    lab += f", below {r['update_below']:g}" if thin and r.get("update_below") else ""
     lab += f", {r['method']}" if r.get("method", "lobatto3") != "lobatto3" else ""
     lab += f", h {r['h']:g}"
     return lab + ("" if r["status"] == "success" else f", fails {r['t_end_reached']:.2f} s")
@@ -137,7 +139,7 @@ def plot_flying3d(records, path, chapter_failures=None) -> dict:
         line, = axes[0].plot(r["t"], r["energy"]["kinetic"] + r["energy"]["strain"], label=_label3d(r), **kw)
         axes[1].semilogy(r["t"], np.abs(r["energy"]["balance"]) + 1e-16, color=line.get_color(), label=_label3d(r),
                          **kw)
-        if r["element"] == "BE3D" and r["status"] != "success":
+        if r["element"] in ("BE3D", "BE3DSR") and r["status"] != "success":
             axes[0].plot([r["t_end_reached"]], [r["energy"]["kinetic"][-1] + r["energy"]["strain"][-1]], "x",
                          color=line.get_color(), ms=9, mew=2)
         if r["element"] == "BE3D":
@@ -186,6 +188,33 @@ def plot_flying3d(records, path, chapter_failures=None) -> dict:
             axes[0, j].legend(fontsize=7)
             axes[2, j].set_xlabel("t (s)")
         figs["fig12_displacement"] = fig
+    mech = [r for r in main if "directors" in r["monitors"] and r["monitors"].get("director_update")]
+    if mech:
+        figs["mechanism"] = _mechanism(mech)
     for stem, f in figs.items():
         save(f, path, stem)
     return figs
+
+
+def _mechanism(records):
+    """The director update's share of the balance, and the director geometry, per BE3D/BE3DSR run."""
+    fig, axes = figure(3, 1, figsize=(9, 9), sharex=True)
+    for k, r in enumerate(records):
+        cum = np.asarray(r["monitors"]["director_update"]["cumulative"])
+        step = r["energy"]["balance"] - cum
+        kw = dict(ls=("-", "--", ":", "-.")[k % 4], lw=1.2)
+        line, = axes[0].plot(r["t"], cum, label=_label3d(r) + ": update part", **kw)
+        axes[0].plot(r["t"], step, color=line.get_color(), lw=0.8, alpha=0.6)
+        geo = r["monitors"]["directors"]
+        axes[1].plot(r["t"], geo["max_angle"], color=line.get_color(), label=_label3d(r), **kw)
+        axes[2].plot(r["t"], geo["min_projection"], color=line.get_color(), **kw)
+    axes[0].set(ylabel="balance parts (J)", title="B3: update part (the jumps of T + U at the director updates; "
+                "thin: the step part)", ylim=(-3, 3))
+    axes[1].set(ylabel="max angle (deg)", title="largest angle between an element's nodal directors")
+    axes[2].set(ylabel="min |d - (d.e1) e1|", xlabel="t (s)", ylim=(0, 1.05),
+                title="smallest interior projection of Eq. 99 (0: frame undefined)")
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+    axes[0].legend(fontsize=6.5)
+    axes[1].legend(fontsize=6.5)
+    return fig

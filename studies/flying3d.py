@@ -39,6 +39,7 @@ import sys
 
 import numpy as np
 
+from ancfdae.monitors import DirectorGeometry
 from ancfdae.simulate import METHODS
 
 from ._cli import Option, main as cli_main
@@ -55,14 +56,19 @@ CHAPTER_FAILURES = {8: 8.0, 16: 9.0, 32: 12.0}
 #: update's share, but it needs a constant mass matrix, and BE3D's rotary inertia depends on the slopes.
 _BE_METHODS = ("lobatto3",)
 
-#: defaults of the full study (chapter: BE3D 8, 16, 32; SQ3D 32, 64, 128; SQ3D 16 to 50 s)
+#: the element types with nodal directors and a director update (audited, their director geometry logged)
+THIN = ("BE3D", "BE3DSR")
+
+#: defaults of the full study (chapter: BE3D 8, 16, 32; SQ3D 32, 64, 128; SQ3D 16 to 50 s); the mechanism:
+#: BE3D on ``variant_mesh`` at h/2 and updating only below a sine of 0.5; BE3DSR, which does not blow up
 FULL = dict(be_meshes=(8, 16, 32), sq_meshes=(32, 64, 128), variants=("projected", "post-rotated", "none"),
             variant_mesh=8, methods=_BE_METHODS, long_run=(16, 50.0), t_end=20.0, t_end_sq=20.0, h=1e-3,
-            dt_out=0.01, t_load=T_HAT, sq_steps=None, em_run=(16, 5e-3))
-#: quick mode (the tests): the hat shortened to 1 s; BE3D and SQ3D with 2 elements to 1.5 s
+            dt_out=0.01, t_load=T_HAT, sq_steps=None, em_run=(16, 5e-3), be_steps=(5e-4,), update_below=(0.5,),
+            sr_meshes=(8, 16), eps_window=10.0)
+#: quick mode (the tests): the hat shortened to 1 s; BE3D, BE3DSR and SQ3D with 2 elements to 1.5 s
 QUICK = dict(be_meshes=(2,), sq_meshes=(2,), variants=("projected",), methods=("lobatto3",), long_run=(),
              t_end=1.5, t_end_sq=1.5, h=2e-3, dt_out=0.02, t_load=1.0, sq_steps=(4e-3, 2e-3),
-             em_run=(2, 4e-3))
+             em_run=(2, 4e-3), be_steps=(), update_below=(), sr_meshes=(2,), eps_window=1.5)
 CLI_OPTIONS = [
     Option("be_meshes", int, "BE3D meshes", nargs="+"),
     Option("sq_meshes", int, "SQ3D meshes", nargs="+"),
@@ -77,6 +83,11 @@ CLI_OPTIONS = [
     Option("t_end", float, "end time of the BE3D runs (s)"),
     Option("t_end_sq", float, "end time of the SQ3D runs (s)"),
     Option("h", float, "time step (s)"),
+    Option("be_steps", float, "further steps of the projected BE3D run on --variant-mesh (none: give 0)", nargs="+"),
+    Option("update_below", float, "projected BE3D runs on --variant-mesh updating only when a director's sine "
+           "falls below these (none: give 0)", nargs="+"),
+    Option("sr_meshes", int, "BE3DSR meshes (none: give 0)", nargs="+"),
+    Option("eps_window", float, "eps_T of B's displacement against the finest SQ3D run over [0, this] s"),
 ]
 
 
@@ -111,17 +122,21 @@ class UpdateAudit:
 
 
 def run_case(case: dict) -> dict:
-    """One B3 run: ``case = {element, n, t_end, h, dt_out, t_load[, director_update, method]}``.
+    """One B3 run: ``case = {element, n, t_end, h, dt_out, t_load[, director_update, update_below, method]}``.
 
-    For BE3D the energy jumps at the director updates are kept in the
-    Result's monitor ``director_update``: ``cumulative`` (their running sum at
-    the output times), ``count`` and ``max_abs``.
+    For BE3D and BE3DSR the energy jumps at the director updates are kept in
+    the Result's monitor ``director_update``: ``cumulative`` (their running sum
+    at the output times), ``count`` and ``max_abs``; the monitor ``directors``
+    (:class:`ancfdae.DirectorGeometry`) logs the director geometry.
     """
     opts = {"director_update": case["director_update"]} if case.get("director_update") else {}
+    if "update_below" in case:
+        opts["update_below"] = case["update_below"]
     beam = b3_beam(case["element"], case["n"], t_load=case["t_load"], **opts)
-    model = UpdateAudit(beam) if case["element"] == "BE3D" else beam
+    thin = case["element"] in THIN
+    model = UpdateAudit(beam) if thin else beam
     rec = simulate_case(model, case["t_end"], method=case.get("method", "lobatto3"), h=case["h"],
-                        dt_out=case["dt_out"])
+                        dt_out=case["dt_out"], monitors=(DirectorGeometry(),) if thin else ())
     if isinstance(model, UpdateAudit):
         res = rec["result"]
         jumps = np.array(model.jumps).reshape(-1, 2)
@@ -131,7 +146,8 @@ def run_case(case: dict) -> dict:
                                            "max_abs": float(np.max(np.abs(jumps[:, 1]))) if jumps.size else 0.0}
     rec.update(element=case["element"], n=case["n"], director_update=case.get("director_update") or "-",
                method=case.get("method", "lobatto3"), t_end=case["t_end"], t_load=case["t_load"], h=case["h"],
-               long=bool(case.get("long")), label=case["label"])
+               long=bool(case.get("long")), label=case["label"],
+               update_below=getattr(beam.element, "update_below", None) if thin else None)
     return rec
 
 
@@ -144,9 +160,10 @@ def _unpack(record):
 def summarize(rec: dict) -> dict:
     """Key numbers of one run: failure and blow-up times, balance during and drift after the load."""
     t, en = rec["t"], rec["energy"]
-    row = {k: rec[k] for k in ("element", "n", "director_update", "method", "dof", "status", "message",
-                               "t_end_reached", "t_end", "t_load", "h", "cpu")}
-    row["chapter_fails"] = CHAPTER_FAILURES.get(rec["n"]) if rec["element"] == "BE3D" else None
+    row = {k: rec.get(k) for k in ("element", "n", "director_update", "method", "dof", "status", "message",
+                                   "t_end_reached", "t_end", "t_load", "h", "cpu", "update_below", "label")}
+    chapter = rec["element"] == "BE3D" and rec["h"] == FULL["h"] and rec.get("update_below") is None
+    row["chapter_fails"] = CHAPTER_FAILURES.get(rec["n"]) if chapter else None
     t_load = rec["t_load"]
     row["t_fail"] = rec["t_fail"]
     row["t_blow_up"] = en["t_blow_up"]
@@ -169,7 +186,27 @@ def summarize(rec: dict) -> dict:
         row["update_max"] = float(audit["max_abs"])
         row["update_mean"] = float(cum[-1] / audit["count"])
         row["update_count"] = int(audit["count"])
+        # the balance split: the update part (the jumps) and the step part (everything else: the integrator)
+        row["step_part_load"] = float(bal[k] - cum[k])
+        row["step_part_free"] = float((bal[-1] - bal[k]) - (cum[-1] - cum[k]))
+    geo = rec["monitors"].get("directors")
+    if geo is not None and len(geo["max_angle"]):
+        row["max_angle"] = float(np.max(geo["max_angle"]))
+        row["min_projection"] = float(np.min(geo["min_projection"]))
     return row
+
+
+def eps_T3(rec: dict, ref: dict, window: float) -> tuple[float, float]:
+    """Integrated error (chapter Eq. 115) of B's displacement in space against ``ref`` over ``[0, window]``,
+    or up to where either run ends; returns ``(eps_T, end of the interval)``."""
+    t, t_ref = rec["t"], ref["t"]
+    end = min(window, float(t[-1]), float(t_ref[-1]))
+    keep = t <= end + 1e-9
+    idx = np.searchsorted(t_ref, t[keep] - 1e-9)
+    if keep.sum() < 2 or np.any(np.abs(t_ref[idx] - t[keep]) > 1e-9):
+        return float("nan"), end
+    e2 = np.sum((rec["tip"][keep] - ref["tip"][idx]) ** 2, axis=1)
+    return float(np.sqrt(np.sum(0.5 * (e2[1:] + e2[:-1]) * np.diff(t[keep])))), end
 
 
 def _cases(o):
@@ -185,6 +222,12 @@ def _cases(o):
     for m in (methods[1:] if be else ()):
         cases.append({"element": "BE3D", "n": o["variant_mesh"], "director_update": o["variants"][0], "method": m,
                       "t_end": o["t_end"], "h": o["h"]})
+    mech = {"element": "BE3D", "n": o["variant_mesh"], "director_update": o["variants"][0], "method": methods[0],
+            "t_end": o["t_end"]}
+    cases += [dict(mech, h=float(h)) for h in (o["be_steps"] if be else ()) if h]
+    cases += [dict(mech, h=o["h"], update_below=float(b)) for b in (o["update_below"] if be else ()) if b]
+    cases += [{"element": "BE3DSR", "n": n, "director_update": o["variants"][0], "method": methods[0],
+               "t_end": o["t_end"], "h": o["h"]} for n in (o["sr_meshes"] if available(("BE3DSR",)) else ()) if n]
     if available(("SQ3D",)):
         for n in o["sq_meshes"]:
             cases += [{"element": "SQ3D", "n": n, "t_end": o["t_end_sq"], "h": hs}
@@ -198,6 +241,7 @@ def _cases(o):
     out = []
     for c in cases:
         label = f"{c['element']} {c['n']} el" + (f" ({c['director_update']})" if c.get("director_update") else "") \
+            + (f" below {c['update_below']:g}" if "update_below" in c else "") \
             + (f" {c['method']}" if c.get("method", "lobatto3") != "lobatto3" else "") \
             + f" h {c['h']:g} to {c['t_end']:g} s" + (" long" if c.get("long") else "")
         out.append(Case(c, dt_out=o["dt_out"], t_load=o["t_load"], label=label))
@@ -207,11 +251,12 @@ def _cases(o):
 
 def _cost(case):
     # relative CPU cost; SQ3D runs go to the end, BE3D runs usually stop early
-    return case["t_end"] * case["n"] / case["h"] * (3.0 if case["element"] == "SQ3D" else 0.3)
+    return case["t_end"] * case["n"] / case["h"] * {"SQ3D": 3.0, "BE3DSR": 6.0}.get(case["element"], 0.3)
 
 
 def run(be_meshes=None, sq_meshes=None, variants=None, variant_mesh=None, methods=None, long_run=None, t_end=None,
-        t_end_sq=None, h=None, em_run=None, dt_out=None, quick: bool = False, out=None, jobs: int | None = None, executor=None,
+        t_end_sq=None, h=None, em_run=None, dt_out=None, be_steps=None, update_below=None, sr_meshes=None,
+        eps_window=None, quick: bool = False, out=None, jobs: int | None = None, executor=None,
         plots: bool = True, progress: bool = True) -> dict:
     """Run the study. Every option left None takes its value from :data:`FULL` (:data:`QUICK` with ``quick``).
 
@@ -238,6 +283,17 @@ def run(be_meshes=None, sq_meshes=None, variants=None, variant_mesh=None, method
         End times of the BE3D and the SQ3D runs.
     h, dt_out : float
         Step and output interval.
+    be_steps : sequence of float
+        Further steps of the ``variants[0]`` BE3D run on ``variant_mesh`` elements (the update's energy is
+        O(h^2) per update, so updating every step drains O(h) overall: halving h halves it).
+    update_below : sequence of float
+        ``variants[0]`` BE3D runs on ``variant_mesh`` elements that update only when a director's sine
+        falls below the value (rare updates).
+    sr_meshes : sequence of int
+        BE3DSR meshes (its default ``update_below=0.5``); its updates keep T and U.
+    eps_window : float
+        ``eps_T`` of every run's displacement of B in space against the finest
+        SQ3D run over ``[0, eps_window]`` s (or up to the failure).
     quick, out, jobs, executor, plots, progress
         The sweep options of every study (:mod:`ancfdae.studies._common`);
         ``quick``: the moment hat shortened to 1 s; BE3D 2 el (h = 2e-3)
@@ -251,11 +307,13 @@ def run(be_meshes=None, sq_meshes=None, variants=None, variant_mesh=None, method
     """
     o = settings(FULL, QUICK, quick, dict(be_meshes=be_meshes, sq_meshes=sq_meshes, variants=variants,
                                           variant_mesh=variant_mesh, methods=methods, long_run=long_run, t_end=t_end,
-                                          t_end_sq=t_end_sq, h=h, dt_out=dt_out, em_run=em_run))
+                                          t_end_sq=t_end_sq, h=h, dt_out=dt_out, em_run=em_run, be_steps=be_steps,
+                                          update_below=update_below, sr_meshes=sr_meshes, eps_window=eps_window),
+                 zero_allowed=("long_run", "em_run"))
     unknown = [m for m in o["methods"] if m not in METHODS]
     if unknown:
         raise OptionError(f"`methods` must be keys of {sorted(METHODS)}, got {unknown}.")
-    missing = [n for n in ("BE3D", "SQ3D") if n not in available(("BE3D", "SQ3D"))]
+    missing = [n for n in ("BE3D", "BE3DSR", "SQ3D") if n not in available(("BE3D", "BE3DSR", "SQ3D"))]
     cases = _cases(o)
     if not cases:
         raise OptionError("flying3d has no case to run: no BE3D/SQ3D meshes, or neither type in ancfdae.models.")
@@ -263,10 +321,16 @@ def run(be_meshes=None, sq_meshes=None, variants=None, variant_mesh=None, method
     sweep = run_cases(run_case, cases, out=path, executor=executor, jobs=jobs, reduce=_unpack, name="flying3d",
                       progress=progress, cost=_cost)
     records = sweep.finished()
-    order = {"BE3D": 0, "SQ3D": 1}
+    order = {"BE3D": 0, "BE3DSR": 1, "SQ3D": 2}
     records.sort(key=lambda r: (order[r["element"]], r["director_update"] != o["variants"][0],
-                                r["method"] != (list(o["methods"]) or ["lobatto3"])[0], r["t_end"], r["n"], -r["h"]))
+                                r["method"] != (list(o["methods"]) or ["lobatto3"])[0], r.get("update_below") or 0,
+                                r["t_end"], r["n"], -r["h"]))
     rows = [summarize(r) for r in records]
+    refs = [r for r in records if r["element"] == "SQ3D" and not r["long"] and r["method"] == "lobatto3"]
+    ref = max(refs, key=lambda r: (r["n"], -r["h"])) if refs else None
+    for row, r in zip(rows, records):
+        row["eps_T"], row["eps_T_to"] = eps_T3(r, ref, o["eps_window"]) if ref is not None else (None, None)
+        row["eps_T_reference"] = ref["label"] if ref is not None else None
     table = _table(rows, missing, sweep.errors)
     figures = {}
     if plots:
@@ -281,21 +345,29 @@ def _table(rows, missing, errors):
     headers = ["element", "#NEL", "director update", "integrator", "h (s)", "run to (s)", "fails at (s)",
                "chapter: fails at (s)", "blow-up flagged (s)", "balance off by 1 % at (s)", "T+U at load end (J)",
                "balance at load end (J)", "drift after load (J)", "drift rate (J/s)",
-               "update jumps, load / free (J)", "per update: mean / max (J)", "CPU (s)"]
+               "update jumps, load / free (J)", "step part, load / free (J)", "per update: mean / max (J)",
+               "max director angle (deg)", "min projection (Eq. 99)", "eps_T of B (m)", "eps_T over (s)", "CPU (s)"]
     body = []
     for r in rows:
-        jumps = per = "-"
+        jumps = per = steps = "-"
         if "update_net_load" in r:
             jumps = f"{r['update_net_load']:.2e} / {r['update_net_free']:.2e}"
+            steps = f"{r['step_part_load']:.2e} / {r['step_part_free']:.2e}"
             per = f"{r['update_mean']:.1e} / {r['update_max']:.1e}"
-        body.append([r["element"], r["n"], r["director_update"], r["method"], f"{r['h']:g}", f"{r['t_end']:g}",
+        update = r["director_update"] + (f", below {r['update_below']:g}" if r.get("update_below") else "")
+        body.append([r["element"], r["n"], update, r["method"], f"{r['h']:g}", f"{r['t_end']:g}",
                      cell(r["t_fail"], ".3f") if r["status"] != "success" else "-",
                      cell(r["chapter_fails"], "g"), cell(r["t_blow_up"], ".2f"), cell(r["t_drift_1pc"], ".2f"),
                      cell(r["energy_at_load_end"], ".4g"), cell(r["balance_at_load_end"], ".2e"),
-                     cell(r["drift_max"], ".2e"), cell(r["drift_rate"], ".2e"), jumps, per, f"{r['cpu']:.0f}"])
+                     cell(r["drift_max"], ".2e"), cell(r["drift_rate"], ".2e"), jumps, steps, per,
+                     cell(r.get("max_angle"), ".1f"), cell(r.get("min_projection"), ".3f"),
+                     cell(r.get("eps_T"), ".3e"), cell(r.get("eps_T_to"), "g"), f"{r['cpu']:.0f}"])
     t_load = rows[0]["t_load"] if rows else T_HAT
+    ref = next((r["eps_T_reference"] for r in rows if r.get("eps_T_reference")), None)
     text = (f"Modified Newton tol 1e-8 (energy-momentum: its own, round-off); the moment ends at {t_load:g} s. "
-            "Chapter: Lobatto IIIA, h = 1e-3 s.\n\n")
+            "Chapter: Lobatto IIIA, h = 1e-3 s. Balance = update part (the jumps of T + U at the director "
+            "updates) + step part (the integrator's). "
+            + (f"eps_T (Eq. 115, B's displacement in space) against {ref}. " if ref else "") + "\n\n")
     text += markdown_table(headers, body)
     if missing:
         text += f"\nNot available in ancfdae.models: {', '.join(missing)}.\n"

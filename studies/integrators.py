@@ -4,7 +4,8 @@ The B2 beam (the project's definition; a small mesh of BE2D) and a stiffer varia
 (Young's modulus x 100: its axial and bending frequencies x 10) are integrated
 over [0, T] by Lobatto IIIA with 3 and 2 stages (modified and full Newton),
 Newmark (beta 1/4, gamma 1/2), HHT (alpha 0.05), generalized-alpha
-(rho_inf 0.8) over a range of step sizes, by Lobatto IIIA (3 stages) over a
+(rho_inf 0.8), energy-momentum and the energy-preserving collocation
+(order 4; Newton to round-off, its own default) over a range of step sizes, by Lobatto IIIA (3 stages) over a
 range of Newton tolerances, and by IDA (BDF, max order 5)
 over a range of relative tolerances. The error of a run is the integrated tip
 error of chapter Eq. 115 against a fine reference (Lobatto IIIA, 3 stages,
@@ -51,6 +52,8 @@ METHODS = {
 }
 if "energy-momentum" in _AVAILABLE:
     METHODS["energy-momentum"] = ("energy-momentum", {}, {"jacobian": "modified"})
+if "energy-collocation" in _AVAILABLE:   # its own Newton default (round-off: the energy is exact)
+    METHODS["energy-collocation"] = ("energy-collocation", {}, None)
 MODELS = {"B2": 1.0, "B2-stiff": 100.0}
 STEPS = (1e-2, 5e-3, 2.5e-3, 1.25e-3, 6.25e-4)
 RTOLS = (1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
@@ -83,7 +86,8 @@ def run_case(case: dict) -> dict:
         rec = simulate_case(beam, case["t_end"], method="ida", h=None, dt_out=case["dt_out"], rtol=case["rtol"])
     else:
         method, opts, newton = METHODS[case["method"]]
-        newton = dict(newton, tol=case.get("newton_tol", 1e-8))
+        if newton is not None:
+            newton = dict(newton, tol=case.get("newton_tol", 1e-8))
         rec = simulate_case(beam, case["t_end"], method=method, h=case["h"], dt_out=case["dt_out"], newton=newton,
                             **opts)
     rec.update({k: case.get(k) for k in ("model", "method", "h", "rtol", "newton_tol", "reference", "label",
@@ -151,7 +155,8 @@ def run(models=None, element=None, n=None, t_end=None, dt_out=None, steps=None, 
     """
     o = settings(FULL, QUICK, quick, dict(models=models, element=element, n=n, t_end=t_end, dt_out=dt_out,
                                           steps=steps, rtols=rtols, newton_tols=newton_tols, methods=methods,
-                                          h_ref=h_ref))
+                                          h_ref=h_ref),
+                 zero_allowed=("rtols", "newton_tols"))
     unknown = [m for m in o["methods"] if m not in METHODS]
     if unknown:
         raise OptionError(f"`methods` must be keys of {list(METHODS)}, got {unknown}.")

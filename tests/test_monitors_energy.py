@@ -104,6 +104,7 @@ def test_modified_newton_matches_full_newton_with_far_fewer_factorizations():
 
 def _chain_drift(method, h):
     res = simulate(SpringChain(3, force=(4.0, 2.0), T=0.5), (0, 1.5), method, h=h, monitors=[EnergyMonitor()])
+    assert res.success, res.message
     return res.monitors["energy"]["max_abs_drift"]
 
 
@@ -113,6 +114,7 @@ def test_balance_includes_work_of_loads(method, declared):
     d1, d2 = _chain_drift(method, 0.02), _chain_drift(method, 0.01)
     assert _order(d1, d2) > declared - 0.5, (d1, d2)
     res = simulate(SpringChain(3, force=(4.0, 2.0), T=0.5), (0, 1.5), method, h=0.01, monitors=[EnergyMonitor()])
+    assert res.success, res.message
     log = res.monitors["energy"]
     assert np.max(np.abs(log["work"])) > 20 * log["max_abs_drift"]  # the loads did real work
 
@@ -120,6 +122,7 @@ def test_balance_includes_work_of_loads(method, declared):
 def test_energy_monitor_log_and_checks():
     res = simulate(SpringChain(2), (0, 0.1), "newmark", h=0.01, t_eval=[0.0, 0.05, 0.1],
                    monitors=[EnergyMonitor(name="E")])
+    assert res.success, res.message
     log = res.monitors["E"]
     for key in ("kinetic", "strain", "potential", "work", "total", "balance", "drift"):
         assert log[key].shape == (3,)

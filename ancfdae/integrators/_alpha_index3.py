@@ -33,13 +33,21 @@ import scipy.sparse as sp
 
 from ancfdae.integrators.protocol import StepOutcome
 
-__all__ = ["index3_step", "index3_equations", "mass_scale"]
+__all__ = ["index3_step", "index3_equations", "mass_scale", "constraint_force"]
 
 
 def mass_scale(M) -> float:
     """Mean of the mass matrix's diagonal (the scale of the constraint rows)."""
     d = np.asarray(sp.csr_matrix(M).diagonal(), dtype=float)
     return float(np.mean(np.abs(d))) if d.size else 1.0
+
+
+def constraint_force(model):
+    """``(t, q, lam) -> G^T lam``: the model's fast path when it has one (:class:`ancfdae.System`)."""
+    fast = getattr(model, "constraint_force", None)
+    if callable(fast):
+        return fast
+    return lambda t, q, lam: model.constraint_jacobian(t, q).T @ lam
 
 
 def index3_equations(st, t: float, h: float):
@@ -63,19 +71,19 @@ def index3_equations(st, t: float, h: float):
         a1 = s * y + const_a          # ((1 - am) ah1 + am ah0 - af a0) / (1 - af), ah1 = y / (beta h^2)
         return q1, v1, a1, sm * x[n:]
 
+    force = constraint_force(model)
+
     def residual(x):
         q1, v1, a1, lam = state(x)
-        G = model.constraint_jacobian(t1, q1)
-        dyn = np.asarray(model.residual(t1, q1, v1, a1), dtype=float) + G.T @ lam
+        dyn = np.asarray(model.residual(t1, q1, v1, a1), dtype=float) + force(t1, q1, lam)
         return np.concatenate([dyn, sm * model.constraints(t1, q1)])
 
     def jacobian(x):
         q1, v1, a1, lam = state(x)
         J = model.jacobian(t1, q1, v1, a1)
         G = sp.csr_matrix(model.constraint_jacobian(t1, q1))
-        A = J.combine(1.0, c_v, s) + model.constraint_force_jacobian(t1, q1, lam)
-        m = G.shape[0]
-        mat = sp.bmat([[A, sm * G.T], [sm * G, sp.csr_matrix((m, m))]], format="csr")
+        mat = st._kkt.assemble([J.combine(1.0, c_v, s), model.constraint_force_jacobian(t1, q1, lam)],
+                               G, sm, G, sm)
         # the round-off of the dynamic rows and of the scaled constraint rows
         return mat, max(st.floor_of(J.K, q1), st.floor_of(sm * G, q1))
 

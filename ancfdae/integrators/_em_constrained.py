@@ -31,6 +31,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from ancfdae.integrators._alpha_index3 import constraint_force
 from ancfdae.integrators.protocol import Quadrature, StepOutcome
 
 __all__ = ["constrained_em_step", "constrained_em_equations"]
@@ -48,14 +49,19 @@ def constrained_em_equations(st, t0: float, h: float):
     hv0 = h * v0
 
     def G_d(qm):
-        return 0.5 * (model.constraint_jacobian(t0, qm) + model.constraint_jacobian(t1, qm))
+        A, B = sp.csr_matrix(model.constraint_jacobian(t0, qm)), sp.csr_matrix(model.constraint_jacobian(t1, qm))
+        if np.array_equal(A.indptr, B.indptr) and np.array_equal(A.indices, B.indices):   # the fixed pattern
+            return sp.csr_matrix((0.5 * (A.data + B.data), A.indices, A.indptr), shape=A.shape)
+        return 0.5 * (A + B)
+
+    force = constraint_force(model)
 
     def residual(x):
         y, lam = x[:n], sm * x[n:]
         u = hv0 + y
         qm = q0 + 0.5 * u
         f, _ = model.nonconservative_force(tm, qm, False)
-        dyn = c * (M @ y) + dg.gradient(q0 + u) - f + G_d(qm).T @ lam
+        dyn = c * (M @ y) + dg.gradient(q0 + u) - f + 0.5 * (force(t0, qm, lam) + force(t1, qm, lam))
         return np.concatenate([dyn, sm * model.constraints(t1, q0 + u)])
 
     def jacobian(x):
@@ -69,11 +75,10 @@ def constrained_em_equations(st, t0: float, h: float):
         # such as point masses on rods, has only the latter)
         floor = max(st.floor_of(J, q0 + u), st.floor_of(G1, q0 + u))
         H = 0.25 * (model.constraint_force_jacobian(t0, qm, lam) + model.constraint_force_jacobian(t1, qm, lam))
-        m = G1.shape[0]
         if sp.issparse(J):
-            A = sp.csr_matrix(c * M + J - 0.5 * Kf + H)
-            return sp.bmat([[A, Gd.T], [G1, sp.csr_matrix((m, m))]], format="csr"), floor
+            return st._kkt.assemble([c * M, J, -0.5 * Kf, H], Gd, 1.0, G1, 1.0), floor
         A = J + (c * M - 0.5 * Kf + H).toarray()
+        m = G1.shape[0]
         return np.block([[A, Gd.T.toarray()], [G1.toarray(), np.zeros((m, m))]]), floor
 
     return residual, jacobian, np.concatenate([st._predict(h), st.lam / sm])

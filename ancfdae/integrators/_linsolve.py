@@ -31,11 +31,17 @@ __all__ = ["factorize", "StageMatrix"]
 COMPILED_SOLVE_MAX = 20
 
 #: Up to this size every sparse matrix is factorised as banded, whatever its bandwidth (banded
-#: LAPACK was faster than dense LAPACK at every width measured there).
+#: LAPACK was faster than dense LAPACK at every width measured there, and than SuperLU up to n = 200
+#: even with a full band: ``benchmarks/solver_selection.py``).
 SMALL = 200
-#: Above ``SMALL``: banded while the band storage rows ``2 kl + ku + 1`` are at most this fraction
-#: of ``n``, otherwise SuperLU.
-BAND_FRACTION = 0.25
+#: Above ``SMALL``: banded while the pattern fills at least this fraction of the band
+#: (``nnz >= BAND_DENSITY n (kl + ku + 1)``), otherwise SuperLU. Measured (``benchmarks/solver_selection.py``,
+#: fill + factor + one solve): on beam patterns (fill 0.3-1) banded takes 0.07-0.25 of SuperLU's time at
+#: every size from 50 to 10^4 and every half bandwidth from 7 to 120, static and dynamic, real and complex;
+#: on a band with dense last rows and columns (a body coupled to every node; fill 0.01-0.04) SuperLU wins
+#: from n = 400 on (banded 2x at 400, 13x at 1000). The earlier rule, banded while ``2 kl + ku + 1 <= n/4``,
+#: sent SQ3D beams of 201-315 coordinates (B1 with 12-16 elements) to SuperLU at 8-11 times the cost.
+BAND_DENSITY = 0.1
 
 _band_cache: dict = {}
 
@@ -213,8 +219,8 @@ def factorize(matrix):
 
     A :class:`StageMatrix` factorises in its eigenbasis. Sparse matrices go
     to LAPACK's banded LU, real or complex, when small
-    (``n <= SMALL``) or narrow-banded (``BAND_FRACTION``), otherwise to
-    SuperLU; dense arrays to dense LAPACK. A singular banded or dense matrix gives
+    (``n <= SMALL``) or when their pattern fills the band (``BAND_DENSITY``, :func:`use_banded`),
+    otherwise to SuperLU; dense arrays to dense LAPACK. A singular banded or dense matrix gives
     ``inf``/``nan`` in the solution (the Newton solver reports that as a
     non-finite correction); SuperLU raises RuntimeError for an exactly
     singular matrix.
@@ -235,10 +241,17 @@ def factorize(matrix):
     return _factorize_pattern(csr.data, csr.indptr, csr.indices, n)
 
 
+def use_banded(n: int, band: tuple, nnz: int) -> bool:
+    """True when banded LAPACK factorises an ``n x n`` matrix of ``nnz`` stored entries and the band
+    ``band`` (of :func:`_band_map`): small, or the pattern fills enough of the band (``BAND_DENSITY``)."""
+    kl, ku = band[0], band[1]
+    return n <= SMALL or nnz >= BAND_DENSITY * n * (kl + ku + 1)
+
+
 def _factorize_pattern(data, indptr, indices, n):
     """Factorise the CSR matrix ``(data, indices, indptr)``; the band map is cached by the identity of
     the pattern arrays, so callers should pass the same arrays every time (the beam's assembler does)."""
     band = _band_map(indptr, indices, n)
-    if n <= SMALL or band[2] <= BAND_FRACTION * n:
+    if use_banded(n, band, indices.size):
         return _Banded(data, band, n)
     return _SuperLU(sp.csr_matrix((data, indices, indptr), shape=(n, n)))

@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from ancfdae.constrained import multipliers
+from ancfdae.kkt import KKTAssembler
 from ancfdae.result import Result
 
 __all__ = ["Recorder"]
@@ -35,6 +36,7 @@ class Recorder:
         self.model, self.monitors = model, monitors
         self.t, self.q, self.v, self.a, self.state = [], [], [], [], []
         self.constrained, self.lam = constrained, []
+        self._kkt = KKTAssembler() if constrained else None
 
     def start(self, t, q, v, a):
         """Start every monitor at the initial state."""
@@ -54,18 +56,26 @@ class Recorder:
                 hook(model)
 
     def sample(self, t, q, v, a, state=None):
-        """Record one output time; ``state`` is the model's event state valid at ``t``."""
-        if self.constrained:    # first: a failing KKT solve leaves the record consistent
-            self.lam.append(multipliers(self.model, float(t), np.asarray(q, float), np.asarray(v, float))[1])
+        """Record one output time; ``state`` is the model's event state valid at ``t``.
+
+        The multipliers are solved and the monitors sample before anything is appended: when either
+        raises (a singular KKT system, a probe whose value changed shape), the output time is not
+        recorded and every log keeps one row per recorded time.
+        """
+        lam = None
+        if self.constrained:
+            lam = multipliers(self.model, float(t), np.asarray(q, float), np.asarray(v, float),
+                              assembler=self._kkt)[1]
+        for m in self.monitors:
+            m.sample(t, q, v, a)
+        if lam is not None:
+            self.lam.append(lam)
         self.t.append(float(t))
         self.q.append(np.array(q, dtype=float))
         self.v.append(np.array(v, dtype=float))
         self.a.append(np.array(a, dtype=float))
         if state is not None:
             self.state.append(state)
-
-        for m in self.monitors:
-            m.sample(t, q, v, a)
 
     def stop_reason(self):
         """The first monitor's request to end the run, or None."""

@@ -4,7 +4,8 @@
 the consistent initial acceleration, output times (grid hits and the stepper's interpolation inside
 a step), monitors (each step's :class:`~.protocol.Quadrature` is passed to ``Monitor.advance``),
 hooks, model events (the ``"step_events"`` capability of :mod:`ancfdae.problem`: BE3D's director
-update), failure handling and the :class:`~ancfdae.result.Result` with the model's description.
+update; after each the stepper restarts with the acceleration consistent with the changed state and
+model, one mass solve per event), failure handling and the :class:`~ancfdae.result.Result` with the model's description.
 It hands the stepper everything through arguments: ``initialize(model, t0, q0, v0, a0, t_bound,
 want_quadrature=...)`` and ``restart(t, q, v, a, model)``. It needs only the :mod:`.protocol`, so
 the stepper base (:mod:`.integrator`, whose ``run`` calls this driver) stands above it.
@@ -12,8 +13,13 @@ the stepper base (:mod:`.integrator`, whose ``run`` calls this driver) stands ab
 Failure handling: a failed step, a monitor asking to stop, or an exception raised by anything
 called during the run -- the model (e.g. a load's time function), a hook, a monitor, the stepper --
 ends the run with status "failed", the exception's type and text in ``message``, ``t_fail`` the
-last time reached and every output up to it. Exceptions are never propagated out of the loop;
-bad *arguments* still raise before the run starts.
+last time reached and every output up to it. What a stepper returns is checked
+(:mod:`._checks`: a StepOutcome, a time inside the step and the span, finite states of the model's
+shape); a bad outcome ends the run as failed with a message naming the stepper. Hooks see
+read-only views of the state and stop the run with any truthy answer. Exceptions are never
+propagated out of the loop, except a KeyboardInterrupt: it is re-raised as
+:class:`~._checks.RunInterrupted` carrying the run so far; bad *arguments* still raise before the
+run starts.
 """
 from __future__ import annotations
 
@@ -30,6 +36,7 @@ from numpy.typing import ArrayLike
 from ancfdae import _validate as validate
 from ancfdae._resultfile import describe_model
 from ancfdae.constrained import consistent_state
+from ancfdae.integrators import _checks
 from ancfdae.integrators._recorder import Recorder
 from ancfdae.integrators.protocol import Stepper
 from ancfdae.problem import Model, capabilities
@@ -82,6 +89,8 @@ def output_times(t_span: tuple[float, float],
                  t_eval: ArrayLike | None) -> tuple[float, float, np.ndarray | None]:
     """Validate ``t_span = (t0, tf)`` and ``t_eval``; return ``(t0, tf, t_out or None)``."""
     try:
+        if isinstance(t_span, (str, bytes)) or any(isinstance(x, (str, bytes)) for x in t_span):
+            raise TypeError("text")     # float("1") would accept it: times are numbers
         t0, tf = (float(x) for x in t_span)
     except (TypeError, ValueError):
         raise ValueError(f"`t_span` must be a pair (t0, tf) of numbers, got {t_span!r}.") from None
@@ -213,9 +222,16 @@ def integrate(stepper: Stepper, model: Model, t_span: tuple[float, float], t_eva
     Returns
     -------
     Result
-        Never raises once the run has started; see the module docstring. ``stats`` are the
+        Never raises once the run has started (but re-raises a KeyboardInterrupt, see below); see
+        the module docstring. ``stats`` are the
         stepper's with the driver's ``model_events``, ``restarts``, ``wall_time`` and ``cpu_time``;
         ``model`` is ``model``'s description (``describe()`` and ``dof_labels()``, when it has them).
+
+    Raises
+    ------
+    RunInterrupted
+        (a KeyboardInterrupt) when Ctrl-C interrupts the run; its ``result`` holds every output up
+        to the interruption (status "failed").
 
     Notes
     -----
@@ -243,7 +259,7 @@ def integrate(stepper: Stepper, model: Model, t_span: tuple[float, float], t_eva
     state_keys = tuple(state) if events else ()
 
     wall, cpu = time.perf_counter(), time.process_time()
-    status, message, t_fail = "failed", "", None
+    status, message, t_fail, interrupted = "failed", "", None, None
     steps = restarts = events_n = 0
     t = t0
     bar = _Progress(progress, t0, tf, getattr(stepper, "name", "run"))
@@ -264,12 +280,12 @@ def integrate(stepper: Stepper, model: Model, t_span: tuple[float, float], t_eva
         while True:
             if steps >= max_steps:
                 raise _Failed(f"more than max_steps = {max_steps} steps before t = {tf:g}")
-            out = stepper.step()
+            out, problem = _checks.step_problem(stepper, stepper.step(), n, t, tf)
+            if problem:
+                raise _Failed(problem)
             if not out.ok:
                 raise _Failed(f"step from t = {t:.9g} failed: {out.message}")
-            t_prev, t = t, float(out.t)
-            if not t > t_prev:
-                raise _Failed(f"the step from t = {t_prev:.9g} made no progress (reported t = {t:.9g})")
+            t_prev, t = t, out.t
             stepper.accept(out)
             steps += 1
             rec.advance(t, out.q, out.v, out.a, out.quadrature)
@@ -290,12 +306,13 @@ def integrate(stepper: Stepper, model: Model, t_span: tuple[float, float], t_eva
                     q_e, v_e, state = ev
                     events_n += 1
                     bound = model.bind(state)
-                    a_e = stepper.a
-                    if getattr(stepper, "consistent_restart", False):
-                        a_e, reason = consistent_acceleration(bound, t, q_e, v_e)
-                        if a_e is None:
-                            raise _Failed(f"acceleration after the model event at t = {t:.9g} failed: {reason}")
-                    stepper.restart(t, np.asarray(q_e, float), np.asarray(v_e, float), a_e, bound)
+                    q_e, v_e = np.asarray(q_e, float), np.asarray(v_e, float)
+                    # the step's own acceleration belongs to the old state and model (a remapped
+                    # torsion rate, a new director field): one mass solve gives the consistent one
+                    a_e, reason = consistent_acceleration(bound, t, q_e, v_e)
+                    if a_e is None:
+                        raise _Failed(f"acceleration after the model event at t = {t:.9g} failed: {reason}")
+                    stepper.restart(t, q_e, v_e, a_e, bound)
                     restarts += 1
                     rec.rebind(bound)
             if on_grid:
@@ -307,13 +324,15 @@ def integrate(stepper: Stepper, model: Model, t_span: tuple[float, float], t_eva
             if t >= tf:
                 status, message = "success", f"reached tf = {tf:g} in {steps} steps"
                 break
-            if any(k(t, stepper.q, stepper.v, stepper.a) is True for k in hooks):
+            if _checks.hooks_stop(hooks, t, stepper.q, stepper.v, stepper.a):
                 status, message = "success", f"stopped by a hook at t = {t:.9g}"
                 break
     except _Failed as exc:
         message, t_fail = str(exc), t
     except Exception as exc:  # noqa: BLE001 - a user's callback must not lose the results
         message, t_fail = f"run ended at t = {t:.9g} by an exception: {type(exc).__name__}: {exc}", t
+    except KeyboardInterrupt as exc:    # Ctrl-C: re-raised below, with the part computed so far
+        message, t_fail, interrupted = f"interrupted (KeyboardInterrupt) at t = {t:.9g}", t, exc
     finally:
         bar.close()
     stats = dict(stepper.stats)     # the stepper's counters, "steps" among them; the driver's beside
@@ -321,9 +340,13 @@ def integrate(stepper: Stepper, model: Model, t_span: tuple[float, float], t_eva
                  wall_time=time.perf_counter() - wall, cpu_time=time.process_time() - cpu)
     if start is not None:
         stats.update(initial_correction_q=start.dq, initial_correction_v=start.dv)
-    return rec.result(n, state_keys=state_keys, status=status, message=message, stats=stats, t_fail=t_fail,
-                      method=getattr(stepper, "name", type(stepper).__name__), options=stepper.options(),
-                      model=describe_model(model))
+    result = rec.result(n, state_keys=state_keys, status=status, message=message, stats=stats, t_fail=t_fail,
+                        method=getattr(stepper, "name", type(stepper).__name__), options=stepper.options(),
+                        model=describe_model(model))
+    if interrupted is not None:
+        raise _checks.RunInterrupted(f"{message}; the run so far is on this exception's `result`", result) \
+            from interrupted
+    return result
 
 
 class _Failed(Exception):

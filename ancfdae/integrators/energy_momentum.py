@@ -71,10 +71,12 @@ What holds exactly (to round-off and the Newton tolerance)
   forces enter through the midpoint Jacobian ``G(q_m)``, an exact discrete derivative for rows at most
   quadratic in ``q`` (``constraint_degree <= 2``, refused otherwise); energy is kept and ``g(t1, q1) = 0``
   holds to round-off (:mod:`ancfdae.integrators._em_constrained`).
-* BE3D: not supported. Its mass matrix depends on the slopes (the rotary inertia of the
-  cross-section), so the kinetic energy is not ``v^T M v / 2`` with a constant ``M`` and the
-  midpoint velocity update no longer yields the energy identity; a discrete gradient of its
-  Hamiltonian in the momenta is not implemented. The constructor raises a ValueError.
+* BE3D, BE3DSR (mass matrix depending on the slopes: the rotary inertia of the cross-section):
+  the kinetic part of :mod:`._kinetic_gradient` (a discrete gradient of ``B = v0^T M(q) v1 / 2``)
+  keeps the energy identity; between director updates the energy is kept to round-off, so the
+  updates' jumps are the only change of the balance. No momentum is claimed; the Gonzalez
+  gradient of the potential is corrected off the translations only. A model with a variable
+  mass needs the ``"mass_forms"`` capability (:mod:`ancfdae.problem`), else a ValueError.
 """
 from __future__ import annotations
 
@@ -87,7 +89,10 @@ from ancfdae._scale import ENERGY_ROUNDOFF
 from ancfdae.integrators._alpha_index3 import mass_scale
 from ancfdae.integrators._discrete_gradient import AVFGradient, GonzalezGradient
 from ancfdae.integrators._em_constrained import constrained_em_step
+from ancfdae.kkt import KKTAssembler
+from ancfdae.integrators._kinetic_gradient import KineticPart
 from ancfdae.integrators._newton_records import NewtonOptions
+from ancfdae.integrators._potential_split import require_potential_model, require_potential_split
 from ancfdae.integrators.newton_stepper import NewtonStepper
 from ancfdae.integrators.protocol import Quadrature, StepOutcome
 from ancfdae.problem import Model, capabilities
@@ -137,17 +142,8 @@ class EnergyMomentum(NewtonStepper):
 
     def __init__(self, model: Model, h: float, *, discrete_gradient: str = "auto", angular_momentum: bool = True,
                  newton: NewtonOptions | dict | None = None) -> None:
-        if not getattr(model, "mass_is_constant", False):
-            raise ValueError("`model` must have a constant mass matrix for method 'energy-momentum' "
-                             f"(mass_is_constant=True), got {type(model).__name__} with mass_is_constant=False "
-                             "(BE3D: the cross-section's rotary inertia depends on the slopes, so the kinetic "
-                             "energy is not quadratic in v with a constant matrix and the scheme's energy "
-                             "identity does not hold).")
-        if "potential" not in capabilities(model):
-            raise ValueError("`model` must declare the 'potential' capability (ancfdae.problem.PotentialModel: "
-                             "potential, potential_gradient, nonconservative_force) for method "
-                             f"'energy-momentum'; {type(model).__name__} declares "
-                             f"{sorted(capabilities(model))}.")
+        self.variable_mass = not getattr(model, "mass_is_constant", False)
+        require_potential_model(model, "energy-momentum", variable_mass=True)
         if "constraints" in capabilities(model) and getattr(model, "constraint_degree", None) not in (1, 2):
             raise ValueError("`model` constraints must be at most quadratic in q (constraint_degree 1 or 2) for "
                              "method 'energy-momentum', whose midpoint constraint Jacobian is then an exact "
@@ -178,17 +174,21 @@ class EnergyMomentum(NewtonStepper):
         self._Mlu = spla.splu(sp.csc_matrix(self._M))
         degree = getattr(model, "potential_degree", None)
         self._dg = (AVFGradient(self.model, degree) if self.discrete_gradient == "avf"
-                    else GonzalezGradient(self.model, self._M, rotations=self.angular_momentum))
+                    else GonzalezGradient(self.model, self._M,
+                                          rotations=self.angular_momentum and not self.variable_mass))
+        self._kin = KineticPart(self.model, self._M) if self.variable_mass else None
 
     def _setup(self):
         """The driver may hand another model instance: bind it; check the residual split."""
         super()._setup()
         if self.model.wrapped is not self._model_bound:
             self._bind(self.model.wrapped)
-        self._check_split(self.t, self.q, self.v)
+        require_potential_split(self.model, self.t, self.q, self.v, "energy-momentum",
+                                variable_mass=self.variable_mass)
         self._constrained = "constraints" in capabilities(self.model)
         if self._constrained:
             self._mscale = mass_scale(self._M)
+            self._kkt = KKTAssembler()
             if self.lam is None:
                 self.lam = np.zeros(self.model.n_constraints)
 
@@ -204,20 +204,6 @@ class EnergyMomentum(NewtonStepper):
         if self.model.wrapped is not self._model_bound:
             self._bind(self.model.wrapped)
 
-    def _check_split(self, t, q, v):
-        """The scheme integrates ``M a + grad P - f_nc``; refuse a model whose residual has more
-        (damping, velocity-dependent loads), which the scheme would silently drop."""
-        m = self.model
-        probe = v + 1.0                                     # a velocity-dependent force must show
-        r = np.asarray(m.residual(t, q, probe, np.zeros_like(q)), dtype=float)
-        split = m.potential_gradient(t, q, False)[0] - m.nonconservative_force(t, q, False)[0]
-        scale = max(float(np.max(np.abs(r), initial=0.0)), float(np.max(np.abs(split), initial=0.0)), 1e-300)
-        err = float(np.max(np.abs(r - split), initial=0.0))
-        if err > 1e-8 * scale:
-            raise ValueError("`model` residual must be M a + dP/dq - f_nc(t, q) for method 'energy-momentum'; "
-                             f"at t = {t:g} it differs from the PotentialModel split by {err:.3g} "
-                             f"(scale {scale:.3g}): damping or velocity-dependent forces are not supported.")
-
     # -- one step ------------------------------------------------------------------------
     def _step_impl(self, t0, h):
         """One discrete-gradient midpoint step from the current state; the state is left unchanged."""
@@ -225,9 +211,11 @@ class EnergyMomentum(NewtonStepper):
             return constrained_em_step(self, t0, h)
         q0, v0 = self.q, self.v
         tm, t1 = t0 + 0.5 * h, t0 + h
-        model, dg, M, c = self.model, self._dg, self._M, 2.0 / (h * h)
+        model, dg, M, c, kin = self.model, self._dg, self._M, 2.0 / (h * h), self._kin
         dg.start(tm, q0)
         hv0 = h * v0
+        if kin is not None:
+            kin.start(q0, v0, h)
 
         # Unknown: y = q1 - q0 - h v0 (the step's deviation from the free flight, O(h^2)). Then
         # v1 - v0 = 2 y / h is formed from y, not from q1 - q0: the energy identity's error is
@@ -236,13 +224,16 @@ class EnergyMomentum(NewtonStepper):
         def residual(y):
             u = hv0 + y
             f, _ = model.nonconservative_force(tm, q0 + 0.5 * u, False)
-            return c * (M @ y) + dg.gradient(q0 + u) - f
+            inertia = kin.residual(y) if kin is not None else c * (M @ y)
+            return inertia + dg.gradient(q0 + u) - f
 
         def jacobian(y):
             u = hv0 + y
             _, Kf = model.nonconservative_force(tm, q0 + 0.5 * u, True)
             J = dg.jacobian(q0 + u)
             floor = self.floor_of(J, q0 + u)      # dG/dq plays the stiffness' part
+            if kin is not None:
+                return (J.toarray() if sp.issparse(J) else J) + kin.jacobian(y) - 0.5 * Kf.toarray(), floor
             if sp.issparse(J):
                 return sp.csr_matrix(c * M + J - 0.5 * Kf), floor
             return J + (c * M - 0.5 * Kf).toarray(), floor
@@ -254,7 +245,8 @@ class EnergyMomentum(NewtonStepper):
         q1 = q0 + (hv0 + y)
         v1 = v0 + (2.0 / h) * y
         # The acceleration at t1 (for interpolation and the next predictor): M a1 = -r(t1, q1, v1, 0).
-        a1 = self._Mlu.solve(-np.asarray(model.residual(t1, q1, v1, np.zeros_like(q1)), dtype=float))
+        r1 = -np.asarray(model.residual(t1, q1, v1, np.zeros_like(q1)), dtype=float)
+        a1 = spla.splu(sp.csc_matrix(model.mass(q1))).solve(r1) if kin is not None else self._Mlu.solve(r1)
         if not np.all(np.isfinite(a1)):
             return StepOutcome.failure(f"the acceleration at t = {t1:.9g} is not finite (the model's residual there)")
         quad = None

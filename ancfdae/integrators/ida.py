@@ -127,7 +127,6 @@ class IDA(Integrator):
     name = "ida"
     order = None
     fixed_step = False
-    consistent_restart = True
     handles_constraints = True
 
     def __init__(self, model: Model, rtol: float = 1e-6, atol: float | ArrayLike | None = None, *,
@@ -322,7 +321,7 @@ class IDA(Integrator):
         Parameters
         ----------
         t, q, v, a, model
-            As for :meth:`~ancfdae.integrators.Integrator.restart` (``a`` consistent: ``consistent_restart``).
+            As for :meth:`~ancfdae.integrators.Integrator.restart`.
         """
         super().restart(t, q, v, a, model)
         if self._ggl is not None:    # multipliers consistent with the changed state (and a with them)

@@ -69,7 +69,6 @@ class Integrator(ABC):
     name: str = "integrator"
     order: int | None = None
     fixed_step: bool = True
-    consistent_restart: bool = False
     #: True for a stepper that integrates models with the ``"constraints"`` capability
     handles_constraints: bool = False
 
@@ -165,7 +164,7 @@ class Integrator(ABC):
         t : float
             Time of the event.
         q, v, a : ndarray
-            The changed state (``a`` consistent when ``consistent_restart``, else the step's own).
+            The changed state; ``a`` is consistent with it and with ``model`` (the driver solves for it).
         model : Model
             The model bound to the event's new state; evaluated from now on (counters carry on).
         """

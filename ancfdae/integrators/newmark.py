@@ -33,15 +33,16 @@ the algorithmic acceleration. Newton matrix:
 """
 from __future__ import annotations
 
+import logging
 import numbers
 
 import numpy as np
 
-import logging
-
 from ancfdae.integrators._affine import affine2, affine3, newmark_predict
 from ancfdae.integrators._alpha_index3 import index3_step, mass_scale
+from ancfdae.kkt import KKTAssembler
 from ancfdae.integrators._newton_records import NewtonOptions
+from ancfdae.integrators.driver import consistent_acceleration
 from ancfdae.integrators.newton_stepper import NewtonStepper
 from ancfdae.integrators.protocol import StepOutcome
 from ancfdae.problem import Model, capabilities
@@ -85,6 +86,7 @@ class _AlphaFamily(NewtonStepper):
         self._constrained = "constraints" in capabilities(self.model)
         if self._constrained:
             self._ah = self.a.copy()
+            self._kkt = KKTAssembler()
             self._mscale = mass_scale(self.model.mass(self.q))
             if self.lam is None:
                 self.lam = np.zeros(self.model.n_constraints)
@@ -103,6 +105,28 @@ class _AlphaFamily(NewtonStepper):
         super().accept(outcome)
         if self._constrained:
             self._ah = self._ah_next
+
+    def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model) -> None:
+        """Carry on after a model event, keeping the algorithmic acceleration's offset.
+
+        For ``am, af != 0`` the carried ``a`` is the algorithmic acceleration, which differs from the
+        physical one by O(h); the event changes the physical part only, so the stepper restarts with
+        ``a + (a_alg - a_old)``, ``a_old`` the physical acceleration of the model before the event at the
+        state before it (one more mass solve). Restarting with ``a`` itself resets the offset at every
+        event: on B3 (BE3D, 8 elements, update every step, ``rho_inf = 0.8``, h = 1e-3 s) that put
+        -5.7e-5 J into the balance in 2 s where keeping it leaves 8.6e-7 J, the method's own error.
+
+        Parameters
+        ----------
+        t, q, v, a, model
+            As for :meth:`~ancfdae.integrators.Integrator.restart` (``a`` consistent with ``model``).
+        """
+        if self.alpha_m != 0.0 or self.alpha_f != 0.0:
+            a_old, reason = consistent_acceleration(self.model, t, self.q, self.v)
+            if a_old is None:
+                raise FloatingPointError(f"the acceleration before the model event failed: {reason}")
+            a = a + (self.a - a_old)
+        super().restart(t, q, v, a, model)
 
     def _step_impl(self, t, h):
         if self._constrained:

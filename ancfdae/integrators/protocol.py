@@ -102,9 +102,6 @@ class Stepper(Protocol):
         True when the constructor takes a step size ``h``.
     h : float or None
         The step size of a fixed-step method.
-    consistent_restart : bool
-        True when a restart after a model event needs an acceleration consistent with the changed
-        state (IDA); else the step's own is passed.
     handles_constraints : bool, optional
         True when the stepper integrates models with the ``"constraints"`` capability
         (:class:`ancfdae.problem.ConstrainedModel`): it adds ``G^T lam`` to the residual and imposes the
@@ -123,7 +120,6 @@ class Stepper(Protocol):
     name: str
     fixed_step: bool
     h: float | None
-    consistent_restart: bool
     t: float
     q: np.ndarray
     v: np.ndarray

@@ -89,6 +89,8 @@ class ConstraintSet:
             self._timed_data.append(np.bincount(_slots(self.G_pattern, bc.row, bc.col), weights=bc.data,
                                                 minlength=nnz))
         self._q_slot = _slots(self.G_pattern, self.qi, self.qj)
+        self._BT = sp.csr_matrix(self.B.T)
+        self._timed_T = [sp.csr_matrix(Bj.T) for _, Bj, _ in self.timed]
         self.H_pattern = _pattern((n, n), self.qj, self.qk)
         self._h_slot = _slots(self.H_pattern, self.qj, self.qk)
 
@@ -116,6 +118,15 @@ class ConstraintSet:
         for d, ph in zip(self._timed_data, self._phis(t)):
             data += ph[0] * d
         return self._csr(self.G_pattern, data)
+
+    def force(self, t: float, q: np.ndarray, lam: np.ndarray) -> np.ndarray:
+        """``G(t, q)^T lam`` without forming ``G`` (the residuals' term, once per Newton iteration)."""
+        f = self._BT @ lam
+        if self.qa.size:
+            f += np.bincount(self.qj, weights=self.qa * lam[self.qi] * q[self.qk], minlength=self.n)
+        for BjT, ph in zip(self._timed_T, self._phis(t)):
+            f += ph[0] * (BjT @ lam)
+        return f
 
     def H(self, lam: np.ndarray) -> sp.csr_matrix:
         """``d(G^T lam)/dq = sum_i lam_i A_i`` on the fixed pattern, shape (n, n)."""

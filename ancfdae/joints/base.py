@@ -13,6 +13,7 @@ from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 
 from ancfdae.joints.rows import Affine, Rows
 
@@ -130,7 +131,6 @@ def vector(arg: str, value, dim: int, *, unit: bool = False) -> np.ndarray:
 
 def constant(x: np.ndarray, n: int) -> Affine:
     """The constant vector ``x`` as an Affine map (the ground's points and vectors)."""
-    import scipy.sparse as sp   # noqa: PLC0415 - local: only the ground needs it
     return Affine(sp.csr_matrix((x.size, n)), np.asarray(x, dtype=float))
 
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ancfdae.joints.base import Frame, Joint, axis, constant, normals, vector
-from ancfdae.joints.rows import Rows, dot, linear
+from ancfdae.joints.rows import Affine, Rows, dot, linear
 
 __all__ = ["Rigid", "Revolute"]
 
@@ -80,7 +80,7 @@ class Rigid(Joint):
                 raise ValueError(f"{label}: frame vector {k} of {fb.label} is not a combination of the frame "
                                  f"vectors of {fa.label} (misfit {miss:.3g}); a weld needs side `a` to span it "
                                  "(swap the sides, or weld to a body with a full frame).")
-            linear(rows, f"{label}.d{k}", d - fa.axes[0].combination(coef, basis))
+            linear(rows, f"{label}.d{k}", d - Affine.combination(coef, basis))
         return rows
 
 

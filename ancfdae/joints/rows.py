@@ -48,10 +48,11 @@ class Affine:
         J = sp.csr_matrix(np.array([[0.0, -1.0], [1.0, 0.0]]))
         return Affine(sp.csr_matrix(J @ self.X), J @ self.x0)
 
-    def combination(self, coef: np.ndarray, others: list[Affine]) -> Affine:
-        """``sum_k coef[k] others[k]`` (constant coefficients)."""
-        X = sum(c * o.X for c, o in zip(coef, others))
-        return Affine(sp.csr_matrix(X), sum(c * o.x0 for c, o in zip(coef, others)))
+    @staticmethod
+    def combination(coef: np.ndarray, vectors: list[Affine]) -> Affine:
+        """``sum_k coef[k] vectors[k]`` (constant coefficients)."""
+        X = sum(c * o.X for c, o in zip(coef, vectors))
+        return Affine(sp.csr_matrix(X), sum(c * o.x0 for c, o in zip(coef, vectors)))
 
 
 @dataclass(frozen=True)

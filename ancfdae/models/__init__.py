@@ -2,6 +2,6 @@
 from .beam import Beam
 from .element import Element
 from .shear import SQ2D, SQ3D
-from .thin import BE2D, BE3D, Cable3D
+from .thin import BE2D, BE3D, BE3DSR, Cable3D
 
-__all__ = ["Element", "Beam", "BE2D", "BE3D", "Cable3D", "SQ2D", "SQ3D"]
+__all__ = ["Element", "Beam", "BE2D", "BE3D", "BE3DSR", "Cable3D", "SQ2D", "SQ3D"]

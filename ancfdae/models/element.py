@@ -24,10 +24,9 @@ Conventions
 * Registry: every subclass that sets its own ``name`` is registered under it
   (:meth:`Element.by_name`), so that a result file, which records the name,
   can rebuild a user's element as well as the built-in ones.
-* Kernel option: an element with a NumPy reference and a compiled twin of its
-  kernels lists both in ``kernel_twins``; setting ``kernel`` builds one
-  :class:`Kernel` object, which the element's kernel methods call. The choice
-  is made once, never per call.
+* Kernel option: an element with a NumPy reference and a compiled twin of its kernels lists both
+  in ``kernel_twins``; setting ``kernel`` builds one :class:`Kernel` object, which the element's
+  kernel methods call. The choice is made once, never per call.
 """
 from __future__ import annotations
 
@@ -328,10 +327,8 @@ class Element(ABC):
                     tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """Generalised force of a dead moment acting at axis point ``s`` of one element.
 
-        The virtual work of a moment is ``M . delta phi`` with the virtual
-        rotation ``delta phi`` of the cross-section frame at ``s``
-        (chapter Sect. 2.2), ``delta phi = G(q) delta q``; the generalised
-        force is ``G^T M``.
+        The virtual work of a moment is ``M . delta phi`` with the virtual rotation ``delta phi`` of the
+        cross-section frame at ``s`` (chapter Sect. 2.2), ``delta phi = G(q) delta q``; the force is ``G^T M``.
 
         Parameters
         ----------
@@ -346,6 +343,11 @@ class Element(ABC):
         dfdq : ndarray, shape (n_edof, n_edof), or None
         """
         return self._twin("moment_load")(geom, q, s, moment, element, tangent)
+
+    def moment_slope_operator(self, s: float, length: float) -> np.ndarray | None:
+        """``S'`` (dim, n_edof), ``r'(s) = S' q_e``, when :meth:`moment_load` is the turn of the axis tangent
+        that the beam applies compiled (:mod:`ancfdae.models.beam.moments_numba`); None (default) if not."""
+        return None
 
     # -- optional: fused compiled assembly ----------------------------------
     def fused_kernel(self, geom: Any) -> tuple[Callable, tuple] | None:

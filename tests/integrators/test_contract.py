@@ -69,7 +69,9 @@ def test_contract(method, opts, model_name):
 def test_all_solutions_agree(method, opts):
     """Every integrator approximates the same motion (reference: Lobatto IIIA-3, small step)."""
     ref = simulate(DoublePendulum(torque=1.0, T=0.5), (0, 1), "lobatto3", h=1e-3, t_eval=[0.5, 1.0])
+    assert ref.success, ref.message
     res = simulate(DoublePendulum(torque=1.0, T=0.5), (0, 1), method, t_eval=[0.5, 1.0], **opts)
+    assert res.success, res.message
     assert res.t.size == 2
     np.testing.assert_allclose(res.q, ref.q, atol=2e-2)
 
@@ -97,11 +99,14 @@ def test_off_grid_output_is_interpolated(method):
     """Off-grid outputs are as accurate as the on-grid ones around them."""
     opts = {"rtol": 1e-6} if method == "ida" else {"h": 0.01}
     ref = simulate(DoublePendulum(), (0, 0.2), "lobatto3", h=1e-3, t_eval=[0.1, 0.105, 0.11])
+    assert ref.success, ref.message
     res = simulate(DoublePendulum(), (0, 0.2), method, t_eval=[0.1, 0.105, 0.11], **opts)
+    assert res.success, res.message
     err = np.abs(res.q - ref.q).max(axis=1)
     assert err[1] <= 2 * max(err[0], err[2]) + 1e-9
     if method != "ida":  # on-grid outputs are the step values themselves
         grid = simulate(DoublePendulum(), (0, 0.2), method, t_eval=[0.1, 0.11], **opts)
+        assert grid.success, grid.message
         np.testing.assert_array_equal(res.q[[0, 2]], grid.q)
 
 
@@ -119,6 +124,7 @@ def test_failure_returns_partial_result(method, opts):
     assert res.t.size >= 5 and res.t[-1] <= res.t_fail + 1e-12  # earlier output intact
     assert np.all(np.isfinite(res.q)) and np.all(np.isfinite(res.v))
     ok = simulate(SpringChain(2), (0.0, 1.0), method, t_eval=np.linspace(0, 1, 21), **opts)
+    assert ok.success, ok.message
     np.testing.assert_allclose(res.q, ok.q[:res.t.size], rtol=0, atol=1e-12)
 
 
@@ -148,6 +154,7 @@ def test_step_by_step_api():
         integ.accept(out)
     assert abs(integ.t - 0.05) < 1e-15 and integ.stats["steps"] == 5
     res = simulate(SpringChain(2), (0, 0.05), "lobatto3", h=0.01)
+    assert res.success, res.message
     np.testing.assert_allclose(integ.q, res.q[-1], atol=1e-14)
 
 

@@ -35,7 +35,7 @@ class _NaNAfterPotential(NaNAfter):
 ALL = [(m, {"rtol": 1e-7} if m == "ida" else {"h": 0.01}) for m in METHODS] + [(SymplecticEuler, {"h": 1e-3})]
 #: methods that need a constant mass matrix and the "potential" capability run on the spring chain
 #: (the double pendulum's mass depends on q)
-NEEDS_POTENTIAL = {"energy-momentum"}
+NEEDS_POTENTIAL = {"energy-momentum", "energy-collocation"}
 IDS = [m if isinstance(m, str) else m.name for m, _ in ALL]
 
 
@@ -55,6 +55,7 @@ def test_every_method_and_a_user_integrator_run_through_simulate(method, opts):
     assert res.monitors["energy"]["total"].shape == (6,) and res.monitors["q0"]["value"].shape == (6, 1)
     assert len(seen) == res.stats["steps"] and np.all(np.diff(seen) > 0)
     ref = simulate(make(), (0, 0.5), "lobatto3", h=1e-3, t_eval=t_eval)
+    assert ref.success, ref.message
     np.testing.assert_allclose(res.q, ref.q, atol=2e-2 if method is SymplecticEuler else 2e-3)
     wrap = _NaNAfterPotential if potential else NaNAfter
     bad = simulate(wrap(SpringChain(2), 0.3), (0.0, 1.0), method, t_eval=np.linspace(0, 1, 21), **opts)
@@ -64,6 +65,7 @@ def test_every_method_and_a_user_integrator_run_through_simulate(method, opts):
 
 def test_user_integrator_converges_at_its_order_and_runs_as_instance():
     ref = simulate(SpringChain(2, force=(2.0, 1.0), T=0.5), (0, 0.5), "lobatto3", h=1e-3, t_eval=[0.5])
+    assert ref.success, ref.message
     err = [np.abs(simulate(SpringChain(2, force=(2.0, 1.0), T=0.5), (0, 0.5), SymplecticEuler, h=h,
                            t_eval=[0.5]).q - ref.q).max() for h in (2e-3, 1e-3)]
     assert 0.9 < np.log2(err[0] / err[1]) < 1.1          # first order (measured 1.0000)
@@ -153,7 +155,9 @@ def test_capabilities_are_declared_not_guessed():
     plain, fast = _Counting(beam()), _Declaring(beam())
     assert capabilities(plain) == frozenset() and "residual_stages" in capabilities(fast)
     r1 = simulate(plain, (0, 0.05), "lobatto3", h=0.01)
+    assert r1.success, r1.message
     r2 = simulate(fast, (0, 0.05), "lobatto3", h=0.01)
+    assert r2.success, r2.message
     assert "residual_stages" not in plain.calls and plain.calls["residual"] > 0
     assert fast.calls["residual_stages"] > 0
     np.testing.assert_allclose(r1.q, r2.q, rtol=0, atol=1e-12)
@@ -218,6 +222,8 @@ def test_ida_error_is_a_stated_factor_of_rtol(rtol):
     catches a tolerance handed to SUNDIALS scaled (e.g. 10 x rtol) as well as a wrong default atol."""
     t_eval = np.linspace(0, 1, 11)
     ref = simulate(DoublePendulum(torque=1.0, T=0.5), (0, 1), "lobatto3", h=2.5e-4, t_eval=t_eval)
+    assert ref.success, ref.message
     res = simulate(DoublePendulum(torque=1.0, T=0.5), (0, 1), "ida", rtol=rtol, t_eval=t_eval)
+    assert res.success, res.message
     err = np.abs(res.q - ref.q).max()
     assert 0.5 * rtol < err < 10 * rtol, err / rtol

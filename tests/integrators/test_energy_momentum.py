@@ -7,30 +7,12 @@ small meshes, run by ``simulate(..., method="energy-momentum")``.
 import numpy as np
 import pytest
 
-from ancfdae import Material, PointForce, PointMoment, RectangularSection, hat, models, pulse, simulate
+from ancfdae import simulate
 from ancfdae.integrators._discrete_gradient import AVFGradient, GonzalezGradient
 from ancfdae.integrators.energy_momentum import EnergyMomentum
 from ancfdae.monitors import EnergyMonitor
-from support.toy_models import SpringChain
-
-MAT = Material(E=1e5, nu=0.3, rho=2500.0)
-SEC = RectangularSection(0.05)
-
-
-def b2(name, n, T=2.5, force=True, **kw):
-    el = getattr(models, name)(MAT, SEC, **kw)
-    f = pulse(T)
-    if el.dim == 2:
-        loads = [PointMoment(0.24, node=0, time=f)] + ([PointForce((0.24, 0.0), node=0, time=f)] if force else [])
-        return models.Beam(el, n, 1.0, start=(0.0, 0.0), direction=(0.6, 0.8), loads=loads)
-    loads = [PointMoment((0.0, 0.0, 0.24), node=0, time=f)]
-    return models.Beam(el, n, 1.0, start=(0.0, 0.0, 0.0), direction=(0.6, 0.8, 0.0), loads=loads)
-
-
-def b3(name, n, t_load=3.0, **kw):
-    el = getattr(models, name)(MAT, SEC, **kw)
-    return models.Beam(el, n, 1.0, start=(0.0, 0.0, 0.0), direction=(0.6, 0.8, 0.0),
-                       loads=[PointMoment((0.1, 0.05, 0.2), node=0, time=hat(t_load / 2))])
+from support.flying_beams import CASES, b2, b3, momenta, total_energy
+from support.toy_models import DoublePendulum, SpringChain
 
 
 def march(model, h, t_end, monitor=None, **options):
@@ -38,23 +20,6 @@ def march(model, h, t_end, monitor=None, **options):
     res = simulate(model, (0.0, t_end), "energy-momentum", h=h, monitors=[monitor] if monitor else (), **options)
     assert res.success, res.message
     return res, list(zip(res.t, res.q, res.v))
-
-
-def total_energy(model, states, t_from):
-    return np.array([model.energy(t, q, v).total for t, q, v in states if t >= t_from - 1e-12])
-
-
-def momenta(model, states):
-    """Linear momentum T^T M v and angular momentum (M v) . (A_k q) of every state (rows)."""
-    T, A = model.symmetry_generators()
-    M = model.mass(None)
-    return (np.array([T.T @ (M @ v) for _, q, v in states]),
-            np.array([[(M @ v) @ (Ak @ q) for Ak in A] for _, q, v in states]))
-
-
-CASES = [("BE2D", 2, {}), ("BE2D", 2, {"formulation": "continuum"}), ("Cable3D", 2, {}),
-         ("SQ2D", 2, {}), ("SQ2D", 2, {"formulation": "continuum"}), ("SQ2D", 2, {"formulation": "continuum-locking"}),
-         ("SQ3D", 2, {}), ("SQ3D", 2, {"formulation": "continuum"})]
 
 
 def _beam(name, n, kw, **b):
@@ -206,10 +171,11 @@ def test_observed_order_two():
     assert abs(slope - 2.0) < 0.15, (slope, errs)
 
 
-def test_be3d_refused_with_reason():
-    beam = b3("BE3D", 2)
-    with pytest.raises(ValueError, match="constant mass matrix"):
-        EnergyMomentum(beam, 1e-2)
+def test_variable_mass_without_its_forms_refused_with_reason():
+    """A configuration-dependent mass needs mass_action and mass_bilinear (BE3D has them: see
+    test_energy_momentum_variable_mass.py)."""
+    with pytest.raises(ValueError, match="'mass_forms' capability"):
+        EnergyMomentum(DoublePendulum(), 1e-2)
 
 
 def test_bad_options():

@@ -40,6 +40,43 @@ def test_wide_large_pattern_goes_to_superlu():
     assert isinstance(ls.factorize(sp.csr_matrix(A)), ls._SuperLU)
 
 
+@pytest.mark.parametrize("n", [201, 250, 290, 316, 1000])
+def test_sq3d_wide_bands_above_200_use_banded_lu(n):
+    # Catches: the 201-315 coordinate gap of the old rule (band storage rows <= n/4), which sent B1 SQ3D
+    # beams of 12-16 elements (half bandwidth 26) to SuperLU at 8-11 times the banded cost.
+    A = _banded(n, 26, 26) + 60 * np.eye(n)
+    lu = ls.factorize(sp.csr_matrix(A))
+    assert isinstance(lu, ls._Banded)
+    b = np.arange(1.0, n + 1)
+    assert np.abs(A @ lu.solve(b) - b).max() <= 1e-12 * np.abs(b).max()
+
+
+def _arrow(n, kl, k):
+    """A band plus ``k`` dense last rows and columns: bandwidth n, little of the band filled."""
+    A = _banded(n, kl, kl) + 4 * kl * np.eye(n)
+    A[n - k:, :] = 0.01
+    A[:, n - k:] = 0.01
+    A[range(n - k, n), range(n - k, n)] = 10.0 * kl
+    return A
+
+
+def test_arrow_patterns_above_small_go_to_superlu_and_below_stay_banded():
+    # Catches: a rule on the band width alone (an arrow's band is the whole matrix; banded LU was measured
+    # 2x slower than SuperLU at n = 400, 13x at 1000) and one that drops the small-size exception.
+    assert isinstance(ls.factorize(sp.csr_matrix(_arrow(400, 7, 1))), ls._SuperLU)
+    assert isinstance(ls.factorize(sp.csr_matrix(_arrow(ls.SMALL, 7, 1))), ls._Banded)
+
+
+def test_band_density_threshold_is_where_the_rule_switches():
+    # Catches: the threshold applied to the wrong quantity (band rows 2 kl + ku + 1 instead of kl + ku + 1,
+    # or nnz counted without the band): at exactly BAND_DENSITY of the band filled it stays banded.
+    n, kl, ku = 500, 30, 30
+    band = (kl, ku, 2 * kl + ku + 1, None, True)
+    at = int(np.ceil(ls.BAND_DENSITY * n * (kl + ku + 1)))
+    assert ls.use_banded(n, band, at) and not ls.use_banded(n, band, at - 1)
+    assert ls.use_banded(ls.SMALL, band, 1)
+
+
 def test_duplicate_entries_are_summed():
     # Catches: assignment instead of accumulation into band storage for a non-canonical CSR.
     data, indices, indptr = np.array([1.0, 2.0, 5.0]), np.array([0, 0, 1]), np.array([0, 2, 3])

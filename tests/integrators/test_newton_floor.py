@@ -95,6 +95,7 @@ def test_the_floor_starts_at_zero_in_every_run():
     first = stepper.run((0.0, 0.3))
     soft = stepper.run((0.1, 0.4))             # k = 1 throughout
     fresh = Newmark(model, 0.01, newton=NewtonOptions(residual_atol=0.0, jacobian="full")).run((0.1, 0.4))
+    assert fresh.success, fresh.message
     assert first.success and soft.success
     np.testing.assert_array_equal(soft.q, fresh.q)
     assert soft.stats["newton_iterations"] == fresh.stats["newton_iterations"] > 0

@@ -19,9 +19,15 @@ def _model():
     return DoublePendulum(torque=1.0, T=0.5)
 
 
+def _final(res):
+    """The state at T of a run that must have succeeded (a failed run is a failure, not an IndexError)."""
+    assert res.success, res.message
+    return res.q[-1]
+
+
 @pytest.fixture(scope="module")
 def reference():
-    return simulate(_model(), (0, T), "lobatto3", h=1 / 2560, newton=NEWTON, t_eval=[T]).q[-1]
+    return _final(simulate(_model(), (0, T), "lobatto3", h=1 / 2560, newton=NEWTON, t_eval=[T]))
 
 
 @pytest.mark.parametrize("method, declared, hs, opts", [
@@ -43,14 +49,14 @@ def test_observed_order(reference, method, declared, hs, opts):
 
 def test_newmark_with_gamma_off_half_is_first_order(reference):
     hs = [1 / 40, 1 / 80, 1 / 160, 1 / 320]
-    errs = [np.max(np.abs(simulate(_model(), (0, T), "newmark", h=h, beta=0.3025, gamma=0.6, newton=NEWTON,
-                                   t_eval=[T]).q[-1] - reference)) for h in hs]
+    errs = [np.max(np.abs(_final(simulate(_model(), (0, T), "newmark", h=h, beta=0.3025, gamma=0.6, newton=NEWTON,
+                                          t_eval=[T])) - reference)) for h in hs]
     assert abs(np.polyfit(np.log(hs), np.log(errs), 1)[0] - 1.0) < 0.2
 
 
 def test_ida_error_shrinks_with_rtol(reference):
     rtols = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8]
-    errs = [np.max(np.abs(simulate(_model(), (0, T), "ida", rtol=r, t_eval=[T]).q[-1] - reference))
+    errs = [np.max(np.abs(_final(simulate(_model(), (0, T), "ida", rtol=r, t_eval=[T])) - reference))
             for r in rtols]
     assert np.all(np.diff(np.log(errs)) < 0), errs
     # max_order 2 (undamped default): error ~ rtol^p with p about 1/2..1

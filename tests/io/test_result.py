@@ -8,7 +8,7 @@ import pytest
 import xarray as xr
 
 from ancfdae import EnergyMonitor, Gravity, Material, PointSensor, RectangularSection, Result, ResultFileError, simulate
-from ancfdae import _resultfile
+from ancfdae import _filecheck, _resultfile
 from ancfdae.export import beam_of
 from ancfdae.models import BE2D, BE3D, SQ2D, SQ3D, Beam, Cable3D
 from support.toy_models import SpringChain
@@ -69,6 +69,7 @@ def test_round_trip_every_integrator(tmp_path, method, h):
 def test_round_trip_every_element_with_model_description(tmp_path, element_cls, options):
     beam = _beam(element_cls, **options)
     res = simulate(beam, (0, 0.02), "lobatto3", h=0.005, monitors=[EnergyMonitor()])
+    assert res.success, res.message
     assert res.model["element"]["type"] == element_cls.name
     if element_cls is BE3D:   # the nodal directors, one row per output, recorded by the driver
         assert res.model_state["directors"].shape == (res.t.size, beam.n_nodes, 3)
@@ -196,22 +197,32 @@ def test_foreign_files_are_clear_errors(tmp_path):
     assert issubclass(ResultFileError, ValueError)
 
 
+def _rewritten(ds, path, refresh_checksums):
+    """Write ``ds`` as a hand-edited file; with ``refresh_checksums`` its checksums are recomputed (a forger)."""
+    ds = ds.copy()
+    if refresh_checksums:
+        ds.attrs[_filecheck.CHECKSUM_ATTR] = json.dumps(_filecheck.checksums(ds))
+    ds.to_netcdf(path, engine="netcdf4", encoding=_filecheck.encoding(ds))
+    return path
+
+
 def test_damaged_content_is_a_clear_error(saved, tmp_path):
+    """Catches an edited file read as data (checksums) and malformed content past the checksums read wrongly."""
     with xr.open_dataset(saved) as ds:
         ds.load()
-    broken = ds.drop_vars("v")
-    broken.to_netcdf(tmp_path / "novar.nc", engine="netcdf4")
     with pytest.raises(ResultFileError, match="novar.nc.*variable 'v' is missing"):
-        Result.load(tmp_path / "novar.nc")
+        Result.load(_rewritten(ds.drop_vars("v"), tmp_path / "novar.nc", False))
+    with pytest.raises(ResultFileError, match="novar2.nc.*variable 'v' is missing"):
+        Result.load(_rewritten(ds.drop_vars("v"), tmp_path / "novar2.nc", True))
     ds.attrs["stats"] = "{not json"
-    ds.to_netcdf(tmp_path / "badattr.nc", engine="netcdf4")
-    with pytest.raises(ResultFileError, match="badattr.nc.*'stats' is not JSON"):
-        Result.load(tmp_path / "badattr.nc")
+    with pytest.raises(ResultFileError, match="badattr.nc.*attribute 'stats' does not match its stored checksum"):
+        Result.load(_rewritten(ds, tmp_path / "badattr.nc", False))
+    with pytest.raises(ResultFileError, match="badattr2.nc.*'stats' is not JSON"):
+        Result.load(_rewritten(ds, tmp_path / "badattr2.nc", True))
     ds.attrs["stats"] = "{}"
     ds.attrs["status"] = "converged"          # read fine, but Result refuses it: still a file error
-    ds.to_netcdf(tmp_path / "badstatus.nc", engine="netcdf4")
     with pytest.raises(ResultFileError, match="badstatus.nc: damaged ancfdae result file: `status` must be one of"):
-        Result.load(tmp_path / "badstatus.nc")
+        Result.load(_rewritten(ds, tmp_path / "badstatus.nc", True))
 
 
 #: A result file written by the code before the result-file module stopped building Results itself
@@ -223,16 +234,20 @@ OLD_FILE = Path(__file__).resolve().parents[1] / "data" / "result_format2_be3d.n
 
 def test_a_file_written_by_earlier_code_loads_and_is_written_again_identically(tmp_path):
     """Catches a change of the on-disk layout (a variable, dimension or attribute renamed or dropped, a
-    dtype or a JSON text changed) that would leave users' earlier files unreadable or new files different."""
+    dtype or a JSON text changed) that would leave users' earlier files unreadable or new files different.
+    The format-2 file has no checksums; written again it is format 3: the same file plus the checksums."""
     old = Result.load(OLD_FILE)
     assert old.success and old.method == "lobatto3" and old.t.size == 5 and old.q.shape == (5, 15)
     assert set(old.monitors) == {"energy", "point@1", "tip_q"} and old.monitors["energy"]["blow_up"] is False
     assert old.model_state["directors"].shape == (5, 3, 3)
     again = old.save(tmp_path / "again.nc")
     with xr.open_dataset(OLD_FILE) as before, xr.open_dataset(again) as after:
+        assert before.attrs.pop("format") == "ancfdae.Result/2" and after.attrs.pop("format") == _resultfile.FORMAT
+        assert after.attrs.pop(_filecheck.CHECKSUM_ATTR)
         xr.testing.assert_identical(before, after)        # values bit for bit, names, dims, attributes
         for name in before.variables:
             assert before[name].dtype == after[name].dtype, name
+            assert bool(after[name].encoding.get("fletcher32")) == (after[name].dtype.kind in "fi"), name
         np.testing.assert_array_equal(old.q, before["q"].values)
     _assert_same(Result.load(again), old)
     beam = beam_of(old)                                    # the description still rebuilds the beam

@@ -128,3 +128,25 @@ def test_spatial_double_pendulum_of_cables():
     assert res.monitors["energy"]["relative_drift"] < 1e-10
     assert res.monitors["constraints"]["max_position"] < 1e-12
     assert abs(res.q[-1][-4]) > 1e-2                   # z of the last node: out of the plane
+
+
+def test_a_body_with_its_own_constraints_comes_first():
+    """A body that declares 'constraints' itself (a rigid body's orthonormal directors, issue 19; here the
+    point-mass toy) contributes its rows before the joints', on its own coordinates (catches a missing
+    column offset or a body's rows dropped)."""
+    from support.numerics import fd_gradient, rel_err
+    from support.pendulum_toy import PointPendulum
+    beam = Beam(BE2D(MAT, SEC), 2, 1.0)
+    toy = PointPendulum(amplitude=0.2)
+    s = System([beam, toy], [Spherical("ground", (beam, 0))])
+    assert s.n_constraints == 4 and s.constraint_labels[:2] == ("body 1: row 0", "body 1: row 1")
+    rng = np.random.default_rng(5)
+    q = s.initial_state()[0] + 0.01 * rng.standard_normal(s.n_dof)
+    v, lam = rng.standard_normal(s.n_dof), rng.standard_normal(4)
+    n = beam.n_dof
+    assert np.allclose(s.constraints(0.3, q)[:2], toy.constraints(0.3, q[n:]))
+    assert rel_err(s.constraint_jacobian(0.3, q).toarray(), fd_gradient(lambda x: s.constraints(0.3, x), q)) < 1e-7
+    H = s.constraint_force_jacobian(0.3, q, lam).toarray()
+    assert rel_err(H, fd_gradient(lambda x: s.constraint_jacobian(0.3, x).T @ lam, q)) < 1e-7
+    assert np.allclose(s.constraint_force(0.3, q, lam), s.constraint_jacobian(0.3, q).T @ lam, atol=1e-13)
+    assert np.allclose(s.constraint_rates(0.3, q, v)[1][:2], toy.constraint_rates(0.3, q[n:], v[n:])[1])

@@ -63,10 +63,10 @@ def test_output_folder_checked_before_any_work(tmp_path, monkeypatch, capsys):
     with pytest.raises(ValueError, match="`out` must be a folder.*existing file"):
         output_dir("toy", file)
     t0 = time.perf_counter()
-    with pytest.raises(SystemExit) as exc:
-        _cli.main(study_toy, ["--out", str(file), "--sleep", "5"])
-    assert exc.value.code == 2 and time.perf_counter() - t0 < 2.0     # at once, not after the runs
-    assert "existing file" in capsys.readouterr().err
+    code = _cli.main(study_toy, ["--out", str(file), "--sleep", "5"])
+    assert code == 2 and time.perf_counter() - t0 < 2.0               # at once, not after the runs
+    err = capsys.readouterr().err.strip()
+    assert "existing file" in err and len(err.splitlines()) == 1      # one line, no usage block
     monkeypatch.chdir(tmp_path)
     assert output_dir("toy", quick=True) == Path("out/toy-quick")     # quick never overwrites the full results
     assert output_dir("toy") == Path("out/toy")

@@ -1,1 +1,1 @@
-"""Helpers of the test suite: finite differences (numerics), toy models, a toy study."""
+"""Helpers of the test suite: finite differences (numerics), toy models, small flying beams, a toy study."""

@@ -34,7 +34,7 @@ def case_fn(case):
 
 def run(n_cases=None, sleep=None, fail=None, quick=False, out=None, jobs=None, progress=True):
     """Run the toy sweep; return ``{"sweep", "table", "path"}``."""
-    o = settings(FULL, QUICK, quick, dict(n_cases=n_cases, sleep=sleep, fail=fail))
+    o = settings(FULL, QUICK, quick, dict(n_cases=n_cases, sleep=sleep, fail=fail), unchecked=("fail", "sleep"))
     path = output_dir(NAME, out, quick)
     pids = path / "pids"
     pids.mkdir(exist_ok=True)
@@ -42,4 +42,4 @@ def run(n_cases=None, sleep=None, fail=None, quick=False, out=None, jobs=None, p
              for i in range(o["n_cases"])]
     sweep = run_cases(case_fn, cases, out=path, jobs=jobs, name="toy", progress=progress)
     rows = [[str(c), "error" if r is None else r["square"]] for c, r in zip(cases, sweep.records)]
-    return {"sweep": sweep, "table": markdown_table(["case", "square"], rows), "path": path}
+    return {"sweep": sweep, "errors": sweep.errors, "table": markdown_table(["case", "square"], rows), "path": path}

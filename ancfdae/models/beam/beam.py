@@ -31,6 +31,7 @@ from . import checks, describe as description, mesh
 from .assembly import Assembler
 from .attach import beam_attachment
 from .loads import LoadSet, load_sequence
+from .mass_forms import MassForms
 from .potential import symmetry_generators
 from .stages import StageEvaluator
 
@@ -44,7 +45,7 @@ def _finish_residual():
     return finish_residual
 
 
-class Beam:
+class Beam(MassForms):
     """A beam of ANCF elements with supports and loads: a Model.
 
     Parameters
@@ -194,10 +195,10 @@ class Beam:
     def capabilities(self) -> frozenset:
         """The optional capabilities this beam offers (see :func:`ancfdae.problem.capabilities`)."""
         caps = {"residual_jacobian", "residual_stages"}
+        if self.mass_is_constant or callable(getattr(self.element, "mass_bilinear", None)):
+            caps.add("potential")       # d/dt(M v) - dT/dq + dP/dq - f_nc; M constant or with its forms
         if not self.mass_is_constant:
-            caps.add("variable_mass")
-        else:
-            caps.add("potential")       # M a + dP/dq - f_nc with a constant M
+            caps |= {"variable_mass"} | ({"mass_forms"} if "potential" in caps else set())
         if self.element.event_state(self.geom):
             caps.add("step_events")
         return frozenset(caps)

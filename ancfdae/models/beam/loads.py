@@ -1,8 +1,16 @@
 """The load set of a :class:`~ancfdae.models.Beam`: its loads as free force vectors, built once, and the
 non-conservative external forces (dead loads with a time function, point moments whose generalised force
-follows the configuration, chapter Sect. 2.2)."""
+follows the configuration, chapter Sect. 2.2).
+
+Point moments of an element that offers :meth:`~ancfdae.models.Element.moment_slope_operator` (BE2D,
+Cable3D: the moment turns the axis tangent) are stacked at construction -- the slope operator at each
+load point, the element's coordinates, its scatter slots -- and applied by one compiled call
+(:func:`.moments_numba.tangent_moments`) while the element runs its compiled kernel; the element's
+``moment_load`` is the path of its NumPy kernel and of every other element, one call per moment.
+"""
 from __future__ import annotations
 
+import functools
 from collections.abc import Iterable
 
 import numpy as np
@@ -15,6 +23,13 @@ from .checks import locate, node_index
 __all__ = ["LoadSet", "load_sequence"]
 
 _LOADS = (PointForce, PointMoment, Gravity, DistributedLoad)
+
+
+@functools.cache
+def _tangent_moments():
+    """The compiled moment pass (imports numba: only reached when the element runs its compiled kernel)."""
+    from .moments_numba import tangent_moments
+    return tangent_moments
 
 
 def load_sequence(loads) -> tuple:
@@ -52,6 +67,9 @@ class LoadSet:
     moments : list
         Point moments ``(time, element, s, moment (3,), element coordinates, scatter)``; their
         generalised force depends on the configuration.
+    stacked : tuple of ndarray or None
+        The moments stacked for the compiled pass (module docstring): element coordinates,
+        slope operators, moment vectors, vector and CSR slots; None when the element offers no slope operator.
     """
 
     def __init__(self, loads: Iterable, element, lengths: np.ndarray, s_nodes: np.ndarray, edofs: np.ndarray,
@@ -96,6 +114,20 @@ class LoadSet:
             else:
                 raise TypeError(f"`loads` entries must be PointForce, PointMoment, Gravity or DistributedLoad, "
                                 f"got {load!r}.")
+        self.stacked = self._stack(assembler, lengths, edofs) if self.moments else None
+
+    def _stack(self, assembler, lengths, edofs):
+        """The moments' arrays for :func:`.moments_numba.tangent_moments`, or None (no slope operator)."""
+        ops = [self.element.moment_slope_operator(loc, float(lengths[e])) for _, e, loc, *_ in self.moments]
+        if any(op is None for op in ops):
+            return None
+        n_el, nd = edofs.shape
+        es = np.array([e for _, e, *_ in self.moments])
+        vslot = assembler._vec_all.reshape(n_el, nd)[es]
+        mslot = assembler._slot_all.reshape(n_el, nd * nd)[es]
+        return (np.ascontiguousarray(edofs[es]), np.ascontiguousarray(np.stack(ops), dtype=float),
+                np.stack([m for _, _, _, m, *_ in self.moments]).astype(float),
+                np.ascontiguousarray(vslot), np.ascontiguousarray(mslot))
 
     @property
     def gravity_only(self) -> bool:
@@ -120,6 +152,12 @@ class LoadSet:
         kdata = None
         if self.moments:
             kdata = np.zeros(self.nnz) if tangent else None
+            if self.stacked is not None and self.element.kernel_in_use == "numba":
+                dofs, ops, moments, vslot, mslot = self.stacked
+                scales = np.array([time(t) for time, *_ in self.moments], dtype=float)
+                _tangent_moments()(np.ascontiguousarray(q_full, dtype=float), dofs, ops, moments, scales, vslot,
+                                   mslot, bool(tangent), f, kdata if tangent else f[:0])
+                return f, kdata
             for time, e, loc, m, dofs, (vmask, vidx, mmask, mslot) in self.moments:
                 scale = time(t)
                 if scale == 0.0:

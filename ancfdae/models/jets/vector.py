@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["Jet", "variable", "dot", "cross", "mul", "chain", "sqrt", "recip", "turn", "combine"]
+__all__ = ["Jet", "variable", "dot", "cross", "mul", "chain", "sqrt", "recip", "turn", "combine", "lin", "constant", "atan2"]
 
 # (a_y, -a_x) = TURN a: a 2-vector turned by -90 degrees.
 _TURN = np.array([[0.0, 1.0], [-1.0, 0.0]])
@@ -146,3 +146,36 @@ def combine(weights, jets: list[Jet]) -> Jet:
             return None
         return sum(w.reshape(w.shape + (1,) * (x.ndim - 1)) * x for w, x in zip(weights, xs))
     return Jet(part("v"), part("g"), part("h"))
+
+
+def lin(ca, a: Jet, cb, b: Jet) -> Jet:
+    """``ca a + cb b`` of two jets of the same shape; ``ca``, ``cb`` constants or per-point arrays (P,)."""
+    def part(x, y):
+        if x is None:
+            return None
+        shape = (-1,) + (1,) * (x.ndim - 1)
+        return np.reshape(ca, shape) * x + np.reshape(cb, shape) * y if np.ndim(ca) or np.ndim(cb) else ca * x + cb * y
+    return Jet(part(a.v, b.v), part(a.g, b.g), part(a.h, b.h))
+
+
+def constant(value: np.ndarray, K: int, order: int = 2) -> Jet:
+    """A jet of the constant ``value`` (P,) or (P, d) over ``K`` variables (zero derivatives)."""
+    value = np.asarray(value, dtype=float)
+    return Jet(value, np.zeros(value.shape + (K,)) if order >= 1 else None,
+               np.zeros(value.shape + (K, K)) if order >= 2 else None)
+
+
+def atan2(s: Jet, c: Jet) -> Jet:
+    """The angle ``atan2(s, c)`` of two scalar jets (for ``s = sin, c = cos`` of an angle times a length)."""
+    v = np.arctan2(s.v, c.v)
+    if s.g is None:
+        return Jet(v)
+    r2 = c.v * c.v + s.v * s.v
+    g = (c.v[:, None] * s.g - s.v[:, None] * c.g) / r2[:, None]
+    if s.h is None:
+        return Jet(v, g)
+    # d/dx_l of (c s_k - s c_k) / r2, dr2/dx_l = 2 (c c_l + s s_l); the antisymmetric parts cancel exactly
+    dr2 = 2.0 * (c.v[:, None] * c.g + s.v[:, None] * s.g)
+    gd = g[:, :, None] * dr2[:, None, :]
+    h = (c.v[:, None, None] * s.h - s.v[:, None, None] * c.h - 0.5 * (gd + np.swapaxes(gd, -1, -2))) / r2[:, None, None]
+    return Jet(v, g, h)

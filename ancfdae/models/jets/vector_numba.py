@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["variable", "dot", "cross", "mul", "chain", "sqrt", "recip", "turn"]
+__all__ = ["variable", "dot", "cross", "mul", "chain", "sqrt", "recip", "turn", "lin", "constant", "atan2"]
 
 _ARR = "float64[:, ::1], float64[:, :, ::1], float64[:, :, :, ::1]"
 
@@ -172,3 +172,59 @@ def turn(V, G, H, o, a, sign, order):
             for l in range(K):
                 H[o, 0, k, l] = sign * H[a, 1, k, l]
                 H[o, 1, k, l] = -sign * H[a, 0, k, l]
+
+
+@njit(_sig("int64", "float64", "int64", "float64", "int64", "int64", "int64"), **_OPTS)
+def lin(V, G, H, o, ca, a, cb, b, d, order):
+    """``ca a + cb b`` of two d-vector jets (constants ``ca, cb``) into row ``o``."""
+    K = G.shape[2]
+    for c in range(d):
+        V[o, c] = ca * V[a, c] + cb * V[b, c]
+    if order >= 1:
+        for c in range(d):
+            for k in range(K):
+                G[o, c, k] = ca * G[a, c, k] + cb * G[b, c, k]
+    if order >= 2:
+        for c in range(d):
+            for k in range(K):
+                for l in range(K):
+                    H[o, c, k, l] = ca * H[a, c, k, l] + cb * H[b, c, k, l]
+
+
+@njit(_sig("int64", "float64[::1]", "int64", "int64"), **_OPTS)
+def constant(V, G, H, o, x, d, order):
+    """The constant d-vector ``x`` into row ``o`` (zero derivatives)."""
+    K = G.shape[2]
+    for c in range(d):
+        V[o, c] = x[c]
+    if order >= 1:
+        for c in range(d):
+            for k in range(K):
+                G[o, c, k] = 0.0
+    if order >= 2:
+        for c in range(d):
+            for k in range(K):
+                for l in range(K):
+                    H[o, c, k, l] = 0.0
+
+
+@njit(_sig("int64", "int64", "int64", "int64"), **_OPTS)
+def atan2(V, G, H, o, s, c, order):
+    """The angle ``atan2(s, c)`` of two scalar jets into the scalar row ``o``."""
+    K = G.shape[2]
+    vs, vc = V[s, 0], V[c, 0]
+    r2 = vc * vc + vs * vs
+    if order >= 2:
+        for k in range(K):
+            gk = (vc * G[s, 0, k] - vs * G[c, 0, k]) / r2
+            dk = 2.0 * (vc * G[c, 0, k] + vs * G[s, 0, k])
+            for l in range(k, K):
+                gl = (vc * G[s, 0, l] - vs * G[c, 0, l]) / r2
+                dl = 2.0 * (vc * G[c, 0, l] + vs * G[s, 0, l])
+                x = (vc * H[s, 0, k, l] - vs * H[c, 0, k, l] - 0.5 * (gk * dl + gl * dk)) / r2
+                H[o, 0, k, l] = x
+                H[o, 0, l, k] = x
+    if order >= 1:
+        for k in range(K):
+            G[o, 0, k] = (vc * G[s, 0, k] - vs * G[c, 0, k]) / r2
+    V[o, 0] = np.arctan2(vs, vc)

@@ -281,9 +281,18 @@ class BE2D(Element):
         N, _, _ = hermite(np.asarray(s, dtype=float), lengths)
         return _expand2(N)
 
+    def moment_slope_operator(self, s: float, length: float) -> np.ndarray | None:
+        """``S'`` (2, 8) at ``s``: :meth:`moment_load` is the turn of the tangent, applied compiled by the beam
+        (None for a subclass with a moment of its own)."""
+        if type(self).moment_load is not BE2D.moment_load:
+            return None
+        _, dN, _ = hermite(np.array([float(s)]), np.array([float(length)]))
+        return _expand2(dN)[0, 0]
+
     def moment_load(self, geom: dict, q: np.ndarray, s: float, moment: np.ndarray, element: int,
                     tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        """Dead moment ``M_z`` at ``s``: ``delta phi = (r' x delta r').e_z / |r'|^2``."""
+        """Dead moment ``M_z`` at ``s``: ``delta phi = (r' x delta r').e_z / |r'|^2`` (the reference of
+        :func:`ancfdae.models.beam.moments_numba.tangent_moments`)."""
         L = geom["L"][[element]]
         _, dN, _ = hermite(np.array([s]), L)
         Sx = _expand2(dN)[0, 0]                        # (2, 8)

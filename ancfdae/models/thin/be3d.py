@@ -18,7 +18,7 @@ from ...materials import CircularSection, Material, RectangularSection
 from ..element import Element, Kernel
 from ..shapes import hermite
 from . import be3d_directors as directors_
-from .be3d_inertia import rotary_inertia, rotary_kinetic_energy
+from .be3d_inertia import rotary_bilinear, rotary_inertia, rotary_kinetic_energy
 from .be3d_kinematics import (DOF, N_EDOF, TorsionRule, curvature_energy, curvatures, director_field, frames,
                               local_variables, spin_gradient)
 from .be3d_moment import moment_load
@@ -311,6 +311,10 @@ class BE3D(Element):
     def kinetic_energy_extra(self, geom: dict, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``1/2 int rho J omega1^2 dxi`` per element."""
         return self.kernels.kinetic_energy(geom, q, v)
+
+    def mass_bilinear(self, geom: dict, q: np.ndarray, u: np.ndarray, w: np.ndarray, order: int = 2) -> tuple:
+        """``1/2 u^T M_rot(q) w`` per element, its q-gradient and Hessian (NumPy, :func:`.be3d_inertia.rotary_bilinear`)."""
+        return rotary_bilinear(geom["inertia"], geom, q, u, w, self.rhoJ, order)
 
     # -- the director event (Sect. 3.6) -------------------------------------
     def event_state(self, geom: dict) -> dict:

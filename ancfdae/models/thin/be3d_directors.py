@@ -40,10 +40,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .be3d_kinematics import frames, spin_gradient
+from .be3d_kinematics import director_field, frames, spin_gradient
 
 __all__ = ["UPDATES", "reference_directors", "fallback_directors", "check_director", "director_sines",
-           "update_directors", "bind", "step"]
+           "update_directors", "director_geometry", "bind", "step"]
 
 #: Values of BE3D's ``director_update`` option.
 UPDATES = ("projected", "post-rotated", "none")
@@ -146,6 +146,37 @@ def update_directors(directors, Q, V, variant):
     V[:, 6] = omega1
     new.setflags(write=False)
     return Q, V, new
+
+
+def director_geometry(directors, q, rule):
+    """How far an element's linearly interpolated director is from degenerating (Sect. 3.6, Eq. 99).
+
+    Parameters
+    ----------
+    directors : ndarray (n_el + 1, 3)
+        The nodal directors (unit vectors after an update).
+    q : ndarray (n_el, 14)
+        Element coordinates.
+    rule : TorsionRule
+        The points at which the interior is examined.
+
+    Returns
+    -------
+    angle : ndarray (n_el,)
+        The angle between the element's two nodal directors (rad).
+    projection : ndarray (n_el,)
+        The smallest length over the points of Eq. 99's unnormalised projection ``|d - (d.e1) e1|`` of the
+        interpolated director ``d = S5 d_A + S6 d_B``: the sine of the director-axis angle at a node, and
+        ``cos(angle / 2)`` at most at the midpoint. The frame is undefined where it reaches zero.
+    """
+    dA, dB = directors[:-1], directors[1:]
+    cos = np.einsum("ei,ei->e", dA, dB) / (np.linalg.norm(dA, axis=-1) * np.linalg.norm(dB, axis=-1))
+    angle = np.arccos(np.clip(cos, -1.0, 1.0))
+    d, _ = director_field(directors, rule)
+    a = np.einsum("epin,en->epi", rule.Ba, q)
+    e1 = a / np.linalg.norm(a, axis=-1, keepdims=True)
+    e30 = d - np.einsum("epi,epi->ep", d, e1)[..., None] * e1
+    return angle, np.min(np.linalg.norm(e30, axis=-1), axis=1)
 
 
 def bind(geom: dict, state: dict) -> dict:

@@ -35,8 +35,9 @@ from __future__ import annotations
 import numpy as np
 
 from .be3d_kinematics import director_field, spin_coefficients, spin_gradient
+from .rotary import mass_bilinear
 
-__all__ = ["rotary_inertia", "rotary_kinetic_energy"]
+__all__ = ["rotary_inertia", "rotary_kinetic_energy", "rotary_bilinear"]
 
 
 def _spin_parts(rule, geom, q, order):
@@ -90,3 +91,19 @@ def rotary_inertia(rule, geom, q, v, acc, rhoJ, tangent=True):
     dfdq = np.sum(Wm * ((BaT @ G @ Ba) * Om[..., None, None] + outer(w, dOm) + outer(c, dom)
                         + om[..., None, None] * (BaT @ A2 @ Ba)), axis=1)
     return f, dfdq, dfdv, dfda
+
+
+def rotary_bilinear(rule, geom, q, u, w, rhoJ, order=2):
+    """``1/2 u^T M_rot(q) w`` per element and, by ``order``, its q-gradient and Hessian (``u, w`` fixed).
+
+    ``omega1 = c(q) . v`` with ``c = N_theta + Sx^T g(r')``, so ``C = dc/dq = Sx^T G Sx`` and
+    ``d2c/dq2 = Sx^T H Sx Sx`` (``G, H`` the first and second derivatives of ``g``); the forms of
+    :func:`.rotary.mass_bilinear` (the energy-momentum integrator's discrete gradient of ``T``).
+    """
+    _, _, G, H, c = _spin_parts(rule, geom, q, 2 if order >= 2 else 1)
+    Ba = rule.Ba
+    n_el, n_pts = rule.wdx.shape
+    P, n = n_el * n_pts, Ba.shape[-1]
+    C = np.einsum("epin,epik,epkm->epnm", Ba, G, Ba).reshape(P, n, n)
+    Hc = (np.einsum("epin,epikl,epkm,eplr->epnmr", Ba, H, Ba, Ba).reshape(P, n, n, n) if order >= 2 else None)
+    return mass_bilinear((rhoJ * rule.wdx).reshape(P), c.reshape(P, n), C, Hc, u, w, n_pts, order)

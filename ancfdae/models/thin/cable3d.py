@@ -201,9 +201,18 @@ class Cable3D(Element):
         N, _, _ = hermite(np.asarray(s, dtype=float), np.asarray(lengths, dtype=float))
         return hermite_operator(N, _DOF, 12)
 
+    def moment_slope_operator(self, s: float, length: float) -> np.ndarray | None:
+        """``S'`` (3, 12) at ``s``: :meth:`moment_load` is the turn of the tangent, applied compiled by the beam
+        (None for a subclass with a moment of its own)."""
+        if type(self).moment_load is not Cable3D.moment_load:
+            return None
+        _, dN, _ = hermite(np.array([float(s)]), np.array([float(length)]))
+        return hermite_operator(dN, _DOF, 12)[0, 0]
+
     def moment_load(self, geom: dict, q: np.ndarray, s: float, moment: np.ndarray, element: int,
                     tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        """Dead moment at ``s``: virtual rotation ``delta phi = r' x delta r' / |r'|^2`` (bending only).
+        """Dead moment at ``s``: virtual rotation ``delta phi = r' x delta r' / |r'|^2`` (bending only; the
+        reference of :func:`ancfdae.models.beam.moments_numba.tangent_moments`).
 
         A cable has no torsional coordinate, so the virtual rotation of its
         cross-section is the turn of the tangent, ``e1 x delta e1``; the

@@ -80,9 +80,11 @@ def test_small_load_bending_and_axial(steel, square):
     EI, EA = steel.E * square.I3, steel.E * square.A
     beam = Beam(BE2D(steel, square), 4, L, supports={0: "clamp"}, loads=[PointForce((0.0, P), node=-1)])
     res = solve_static(beam, load_steps=1)
+    assert res.success, res.message
     assert beam.position(res.q, L)[1] == pytest.approx(P * L**3 / (3 * EI), rel=1e-8)
     beam = Beam(BE2D(steel, square), 4, L, supports={0: "clamp"}, loads=[PointForce((P * 1e3, 0.0), node=-1)])
     res = solve_static(beam, load_steps=1)
+    assert res.success, res.message
     assert beam.position(res.q, L)[0] - L == pytest.approx(1e3 * P * L / EA, rel=1e-8)
 
 

@@ -59,6 +59,7 @@ def test_b1_in_plane_reproduces_be2d_and_table2(steel, square):
         assert res.iterations == 49
         planar = Beam(BE2D(steel, square), n, 2.0, supports={0: "clamp"}, loads=[PointForce((0.0, F), node=-1)])
         res2 = solve_static(planar)
+        assert res2.success, res2.message
         assert np.allclose(u[:2], planar.position(res2.q, 2.0) - [2.0, 0.0], rtol=0, atol=1e-11)
         Q = beam.nodal(res.q)
         assert np.abs(Q[:, [2, 5, 6]]).max() < 1e-14    # z, z', theta stay zero
@@ -165,10 +166,12 @@ def test_small_load_bending_about_both_axes_axial_and_torsion(steel):
     for load, k, expect in cases:
         beam = Beam(BE3D(steel, FLAT), 4, L, supports={0: "clamp"}, loads=[load])
         res = solve_static(beam, load_steps=1)
+        assert res.success, res.message
         assert (beam.position(res.q, L) - [L, 0, 0])[k] == pytest.approx(expect, rel=1e-8)
     T = 10.0
     beam = Beam(BE3D(steel, FLAT), 4, L, supports={0: "clamp"}, loads=[PointMoment((T, 0.0, 0.0), node=-1)])
     res = solve_static(beam, load_steps=1)
+    assert res.success, res.message
     theta = beam.nodal(res.q)[:, 6]
     GJk = G * FLAT.J * FLAT.k_t
     assert theta[-1] == pytest.approx(T * L / GJk, rel=1e-8)

@@ -41,6 +41,7 @@ def test_ida_with_director_updates():
     D = res.model_state["directors"]
     assert D.shape == (25, 3, 3) and np.unique(D, axis=0).shape[0] >= 3
     ref = simulate(spinning(update_below=0.9), (0, 0.6), "lobatto3", h=1e-3, t_eval=t_eval, monitors=mon)
+    assert ref.success, ref.message
     assert ref.stats["restarts"] == ref.stats["model_events"] >= 3
     np.testing.assert_allclose(res.monitors["tip"]["position"], ref.monitors["tip"]["position"], rtol=0, atol=1e-5)
 
@@ -49,7 +50,9 @@ def test_same_beam_simulated_twice_and_solved_twice_is_identical():
     """The defect: simulate/solve_static changed the beam's directors in place (tips 0.52 m apart)."""
     beam = spinning()
     r1 = simulate(beam, (0, 0.4), "lobatto3", h=2e-3)
+    assert r1.success, r1.message
     r2 = simulate(beam, (0, 0.4), "lobatto3", h=2e-3)
+    assert r2.success, r2.message
     assert r1.stats["model_events"] > 0
     np.testing.assert_array_equal(r1.q, r2.q)
     np.testing.assert_array_equal(r1.model_state["directors"], r2.model_state["directors"])
@@ -66,10 +69,13 @@ def test_same_beam_simulated_twice_and_solved_twice_is_identical():
 
 def test_a_run_resumes_from_its_saved_state():
     whole = simulate(b3(), (0, 0.4), "lobatto3", h=1e-3, t_eval=[0.2, 0.4])
+    assert whole.success, whole.message
     half = simulate(b3(), (0, 0.2), "lobatto3", h=1e-3, t_eval=[0.2])
+    assert half.success, half.message
     state = {k: v[-1] for k, v in half.model_state.items()}
     rest = simulate(b3(), (0.2, 0.4), "lobatto3", h=1e-3, t_eval=[0.4], q0=half.q[-1], v0=half.v[-1],
                     state0=state)
+    assert rest.success, rest.message
     # same steps; only the restart's exactly consistent acceleration differs (Newton tolerance): measured
     # 2e-9, against 9e-4 when the run restarts from the initial directors (state0 omitted)
     np.testing.assert_allclose(rest.q[-1], whole.q[-1], rtol=0, atol=1e-8)

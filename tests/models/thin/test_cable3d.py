@@ -30,6 +30,7 @@ def test_b1_in_plane_reproduces_be2d_and_table2(steel, square):
         assert res.iterations == 49
         planar = Beam(BE2D(steel, square), n, 2.0, supports={0: "clamp"}, loads=[PointForce((0.0, F), node=-1)])
         res2 = solve_static(planar)
+        assert res2.success, res2.message
         assert np.allclose(u[:2], planar.position(res2.q, 2.0) - [2.0, 0.0], rtol=0, atol=1e-11)
         assert abs(u[2]) < 1e-14
 
@@ -102,6 +103,7 @@ def test_small_load_bending_axial_and_total_mass(steel, square):
                           ((1e3 * P, 0.0, 0.0), 1e3 * P * L / EA)]:
         beam = Beam(Cable3D(steel, square), 4, L, supports={0: "clamp"}, loads=[PointForce(force, node=-1)])
         res = solve_static(beam, load_steps=1)
+        assert res.success, res.message
         u = beam.position(res.q, L) - [L, 0.0, 0.0]
         k = int(np.argmax(np.abs(force)))
         assert u[k] == pytest.approx(expect, rel=1e-8)

@@ -1,0 +1,299 @@
+"""A fourth-order energy-preserving integrator: HBVM(k, 2), the energy-preserving Gauss collocation.
+
+The scheme
+----------
+For ``M a + grad P(q) = f_nc(t, q)`` with a constant ``M`` (:class:`ancfdae.problem.PotentialModel`,
+as for :class:`~ancfdae.integrators.EnergyMomentum`), one step seeks the acceleration over
+``[t0, t0 + h]`` as a polynomial of degree 1 and the position ``sigma`` as one of degree 2, as the
+2-stage Gauss collocation does, but projects the forces onto the polynomial basis with a ``k``-point
+Gauss rule, ``k >= 2`` (the *silent stages*), instead of collocating at 2 points:
+
+    M Y_i / h^2 = sum_l b_l P_i(c_l) F(t0 + c_l h, sigma(c_l h)),   i = 0, 1,   F = f_nc - grad P
+
+(Hamiltonian boundary value method HBVM(k, 2): Brugnano, Iavernaro and Trigiante, JNAIAM 5:17, 2010;
+the energy-preserving variant of collocation: Hairer, JNAIAM 5:73, 2010; the notation in
+:mod:`ancfdae.integrators._hbvm_coefficients`). The unknowns are the two Legendre coefficients of the
+acceleration, ``2 n_dof`` numbers as for Lobatto IIIA-3; only the number of force evaluations per
+residual grows with ``k``. Only the conservative force ``grad P`` needs the ``k`` nodes: the loads
+``f_nc`` are projected with the 2-point Gauss rule (``k = 2``, the Gauss method's own rule, order 4),
+which on B2 halves the cost of a residual (BE2D's dead moment depends on the slopes and is evaluated
+per node in Python, several times the compiled internal forces).
+
+What holds
+----------
+* Order 4 in ``q`` and ``v`` (``2 s``), symmetric, for every ``k >= 2``.
+* Energy: ``T1 - T0 + P1 - P0 = h sum_j b_j f_nc(t_j, sigma_j) . sigma'_j`` (2 Gauss nodes ``j``) whenever the ``k``-point
+  rule integrates ``grad P(sigma(c)) . sigma'(c)`` exactly: for a polynomial ``P`` of degree
+  ``nu <= k`` (``2 k / s``). The default ``k`` is therefore the declared ``potential_degree`` (4 for
+  the St. Venant-Kirchhoff continuum formulations); for the other potentials (BE2D, Cable3D, the
+  structural SQ formulations) :data:`SMOOTH_SILENT_STAGES`, where the energy error per step,
+  ``O(h^(2k+1))``, lies below round-off at the steps that resolve the motion. The step hands the
+  loads' rule to the monitors (:class:`~ancfdae.integrators.Quadrature`: nodes ``t_j``, ``sigma_j``,
+  ``sigma'_j``, weights ``h b_j``), so ``T + U + V - W_ext`` is constant under loads.
+* Linear momentum ``T^T M v``: exact (the rule sums internal forces orthogonal to the translations).
+  Angular momentum: not exact (the forces are evaluated off the configuration a rotation invariant
+  needs); it drifts at the truncation error's size (``docs/energy_momentum.md``).
+
+Newton
+------
+Modified Newton on the shared solver, driven to round-off as the energy identity needs (the
+defaults of :data:`~ancfdae.integrators.energy_momentum.DEFAULT_NEWTON`). The exact Jacobian of the
+stage equations is ``dR_i/dY_m = delta_im M / h^2 + sum_l C[i, m, l] H_l - sum_j C'[i, m, j] Kf_j`` with
+the Hessian ``H_l`` of ``P`` at every node and the load tangent ``Kf_j`` at the loads' nodes (real,
+``2 n_dof`` square, interleaved, banded). The default iteration matrix freezes
+one stiffness ``K`` of the residual, at the step's midpoint: then ``sum_l C[:, :, l] = X^2`` and the matrix splits in the
+eigenbasis of ``X`` (eigenvalues ``1/4 +- i / sqrt(48)``, those of Lobatto IIIA-3's implicit block)
+into one complex ``n_dof`` square banded LU, as Lobatto IIIA-3 (:class:`~ancfdae.integrators._linsolve.StageMatrix`).
+A step that fails with it is retried with the exact Jacobian; full Newton uses the exact Jacobian.
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ancfdae import _validate as validate
+from ancfdae._scale import ENERGY_ROUNDOFF
+from ancfdae.integrators._hbvm_coefficients import hbvm_coefficients
+from ancfdae.integrators._linsolve import StageMatrix
+from ancfdae.integrators._newton_records import NewtonOptions
+from ancfdae.integrators._potential_split import require_potential_model, require_potential_split
+from ancfdae.integrators.energy_momentum import DEFAULT_NEWTON
+from ancfdae.integrators.newton_stepper import NewtonStepper
+from ancfdae.integrators.protocol import Quadrature, StepOutcome
+from ancfdae.problem import JacobianBlocks, Model
+
+__all__ = ["EnergyCollocation", "SMOOTH_SILENT_STAGES", "ITERATION_MATRICES"]
+
+#: Silent stages for a potential that is not a polynomial (chosen by measurement, see docs/energy_momentum.md).
+SMOOTH_SILENT_STAGES = 6
+ITERATION_MATRICES = ("split", "exact")
+_S = 2          # fundamental stages: order 4
+
+
+class _SplitMatrix(StageMatrix):
+    """The frozen iteration matrix ``M / h^2 + K X^2`` for the unknowns ``Y = h^2 gamma``.
+
+    :class:`StageMatrix` with ``a = X`` solves for ``gamma`` (acceleration units); the solution is
+    scaled by ``h^2``.
+    """
+
+    def factorize(self):
+        return _Scaled(super().factorize(), self.h * self.h)
+
+
+class _Scaled:
+    def __init__(self, inner, factor):
+        self.inner, self.factor = inner, factor
+        self.singular = getattr(inner, "singular", False)
+
+    def solve(self, rhs):
+        return self.factor * self.inner.solve(rhs)
+
+
+def interleaved_pattern(indptr: np.ndarray, indices: np.ndarray, n: int, m: int) -> tuple:
+    """Index map from per-entry block values ``(nnz, m, m)`` to an interleaved CSR of size ``n m``.
+
+    Row ``p m + i``, column ``q m + j`` holds block ``(i, j)`` at ``(p, q)`` of the shared pattern.
+
+    Returns
+    -------
+    order, big_indices, big_indptr : ndarray
+        ``csr_matrix((vals.ravel()[order], big_indices, big_indptr))``.
+    """
+    nnz = indices.size
+    row = np.repeat(np.arange(n), np.diff(indptr))
+    e, i, j = (g.ravel() for g in np.meshgrid(np.arange(nnz), np.arange(m), np.arange(m), indexing="ij"))
+    order = np.lexsort((j, e, i, row[e]))
+    big_indices = (indices[e] * m + j)[order]
+    big_indptr = np.r_[0, np.cumsum(np.repeat(np.diff(indptr) * m, m))]
+    return order, big_indices, big_indptr
+
+
+class EnergyCollocation(NewtonStepper):
+    """HBVM(k, 2): order 4 and the energy kept exactly; see the module docstring.
+
+    Parameters
+    ----------
+    model : Model with the ``"potential"`` capability
+        Constant mass matrix (``mass_is_constant``), residual ``M a + dP/dq - f_nc(t, q)``.
+    h : float
+        Step size (> 0); the last step is shortened to end at the bound.
+    silent_stages : int or "auto"
+        ``k >= 2``, the Gauss nodes of the force projection. ``"auto"``: the declared
+        ``potential_degree`` (at least 2; the energy is then exact), else :data:`SMOOTH_SILENT_STAGES`.
+    iteration_matrix : {"split", "exact"}
+        Modified Newton's matrix: ``"split"`` (one stiffness at the midpoint, one complex ``n_dof``
+        LU; the default, chosen by measurement) or ``"exact"`` (the exact Jacobian, ``2 n_dof``
+        real LU). Full Newton always uses the exact Jacobian.
+    newton : NewtonOptions or dict, optional
+        Default :data:`~ancfdae.integrators.energy_momentum.DEFAULT_NEWTON` (relative tolerance
+        1e-15 so that the residual's round-off floor decides, refresh at rate 0.1, 40 iterations).
+    """
+
+    name = "energy-collocation"
+    order = 4
+    fixed_step = True
+    FLOOR_ROUNDOFF = ENERGY_ROUNDOFF
+    FLOOR_UPDATE = "replace"     # as energy-momentum: the energy identity needs the latest floor
+
+    def __init__(self, model: Model, h: float, *, silent_stages: int | str = "auto",
+                 iteration_matrix: str = "split", newton: NewtonOptions | dict | None = None) -> None:
+        require_potential_model(model, self.name)
+        super().__init__(model, h, newton=DEFAULT_NEWTON if newton is None else newton)
+        degree = getattr(model, "potential_degree", None)
+        if isinstance(silent_stages, str) and silent_stages == "auto":
+            k = max(_S, int(degree)) if degree is not None else SMOOTH_SILENT_STAGES
+        elif isinstance(silent_stages, (int, np.integer)) and not isinstance(silent_stages, bool) \
+                and silent_stages >= _S:
+            k = int(silent_stages)
+        else:
+            raise ValueError(f"`silent_stages` must be 'auto' or an integer >= {_S}, got {silent_stages!r}.")
+        self.silent_stages = k
+        self.iteration_matrix = validate.choice("iteration_matrix", iteration_matrix, ITERATION_MATRICES)
+        self._co = hbvm_coefficients(k, _S)
+        self._loads = hbvm_coefficients(_S, _S)      # the 2-point Gauss rule of the loads
+        self._pattern = None
+
+    def options(self) -> dict:
+        """The options as a JSON-able dict: ``h``, the Newton options, ``silent_stages``, ``iteration_matrix``."""
+        o = super().options()
+        o.update(silent_stages=self.silent_stages, iteration_matrix=self.iteration_matrix)
+        return o
+
+    def _setup(self):
+        """Mass matrix of the run's model, its factorisation, the split check; no predictor yet."""
+        super()._setup()
+        self._bind()
+        require_potential_split(self.model, self.t, self.q, self.v, self.name)
+
+    def _bind(self):
+        m = self.model
+        self._M = sp.csr_matrix(m.mass(self.q))
+        self._Mlu = spla.splu(sp.csc_matrix(self._M))
+        z = np.zeros(self.n_dof)
+        self._Mcsr = sp.csr_matrix(m.jacobian(self.t, self.q, z, z).M)   # the mass on the stiffness' pattern
+        self._prev = None          # (h, Y) of the last step: the predictor
+
+    def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model) -> None:
+        """Carry on from a state a model event changed (the predictor is dropped, the model rebound)."""
+        super().restart(t, q, v, a, model)
+        self._bind()
+
+    # -- the stage equations --------------------------------------------------------------------
+    def _nodes(self, t0, h, Y, co):
+        """Times and positions ``sigma`` of the nodes of the rule ``co`` for the unknowns ``Y``."""
+        return t0 + co.c * h, self.q[:, None] + np.outer(h * self.v, co.c) + Y @ co.Wq.T
+
+    def _forces(self, t0, h, Y):
+        """``sum_l BP[i, l] (grad P - f_nc)(sigma_l)``: the conservative force at the ``k`` nodes, the
+        loads at the 2 Gauss nodes (the Gauss method's own rule: order 4, and the work of the loads is
+        that rule's, handed to the monitors)."""
+        m, co, ld = self.model, self._co, self._loads
+        ts, Q = self._nodes(t0, h, Y, co)
+        G = np.column_stack([m.potential_gradient(t, Q[:, l], False)[0] for l, t in enumerate(ts)])
+        ts, Q = self._nodes(t0, h, Y, ld)
+        F = np.column_stack([m.nonconservative_force(t, Q[:, l], False)[0] for l, t in enumerate(ts)])
+        return G @ co.BP.T - F @ ld.BP.T
+
+    def _exact(self, t0, h, Y):
+        """The exact Jacobian ``delta_im M / h^2 + sum_l C[i, m, l] H_l - sum_j Cnc[i, m, j] Kf_j`` (Hessians
+        ``H_l`` of ``P`` at the ``k`` nodes, load tangents ``Kf_j`` at the 2 Gauss nodes), interleaved CSR,
+        and the round-off floor of the largest Hessian."""
+        m, co, ld = self.model, self._co, self._loads
+        ts, Q = self._nodes(t0, h, Y, co)
+        H = [m.potential_gradient(t, Q[:, l], True)[1] for l, t in enumerate(ts)]
+        floor = max(self.floor_of(K, Q[:, l]) for l, K in enumerate(H))
+        ts, Q = self._nodes(t0, h, Y, ld)
+        Kf = [m.nonconservative_force(t, Q[:, l], True)[1] for l, t in enumerate(ts)]
+        return self._assemble(H, Kf, h), floor
+
+    def _assemble(self, H, Kf, h):
+        """``delta_im M / h^2 + sum_l C[i, m, l] H[l] - sum_j Cnc[i, m, j] Kf[j]`` as an interleaved CSR."""
+        co, ld, n = self._co, self._loads, self.n_dof
+        mats = [sp.csr_matrix(A) for A in list(H) + list(Kf)] + [self._Mcsr]
+        weights = np.concatenate([co.C, -ld.C, np.eye(_S)[:, :, None] / (h * h)], axis=2)   # (s, s, k + 2 + 1)
+        A0 = mats[0]
+        if all(A.indptr is A0.indptr and A.indices is A0.indices for A in mats) or all(
+                np.array_equal(A.indptr, A0.indptr) and np.array_equal(A.indices, A0.indices) for A in mats):
+            if self._pattern is None or not np.array_equal(self._pattern[0], A0.indptr) \
+                    or not np.array_equal(self._pattern[1], A0.indices):
+                self._pattern = (A0.indptr, A0.indices, *interleaved_pattern(A0.indptr, A0.indices, n, _S))
+            _, _, order, big_indices, big_indptr = self._pattern
+            vals = np.einsum("iml,le->eim", weights, np.stack([A.data for A in mats]))   # (nnz, s, s)
+            return sp.csr_matrix((vals.ravel()[order], big_indices, big_indptr), shape=(_S * n, _S * n))
+        out = None
+        for i in range(_S):
+            for j in range(_S):
+                B = sum(w * A for w, A in zip(weights[i, j], mats))
+                E = sp.csr_matrix(([1.0], ([i], [j])), shape=(_S, _S))
+                term = sp.kron(B, E, format="csr")
+                out = term if out is None else out + term
+        return out.tocsr()
+
+    def stage_equations(self, t0: float, h: float, split: list):
+        """The step's equations from the current state: ``(residual(x), jacobian(x))`` of the unknowns
+        ``x = Y.ravel()`` (interleaved); ``jacobian`` returns ``(matrix, floor)``, the split matrix while
+        ``split[0]`` is true, else the exact Jacobian."""
+        co, n, model = self._co, self.n_dof, self.model
+        q0, v0 = self.q, self.v
+        M, ih2 = self._M, 1.0 / (h * h)
+        zn = np.zeros(n)
+
+        def residual(x):
+            Y = x.reshape(n, _S)
+            return (ih2 * (M @ Y) + self._forces(t0, h, Y)).ravel()
+
+        def jacobian(x):
+            Y = x.reshape(n, _S)
+            if split[0]:
+                qm = q0 + 0.5 * h * v0 + Y @ co.mid
+                blk = model.jacobian(t0 + 0.5 * h, qm, zn, zn)
+                if blk.same_pattern:
+                    K = blk.K
+                    blk = JacobianBlocks(K, sp.csr_matrix((np.zeros_like(K.data), K.indices, K.indptr),
+                                                          shape=K.shape), blk.M, True)
+                    return _SplitMatrix(blk, h, co.X), self.floor_of(K, qm)
+            return self._exact(t0, h, Y)
+
+        return residual, jacobian
+
+    def _step_impl(self, t0, h):
+        """One HBVM(k, 2) step from the current state; the state is left unchanged."""
+        co, n, model = self._co, self.n_dof, self.model
+        q0, v0 = self.q, self.v
+        split = [self.iteration_matrix == "split" and self.newton.options.jacobian == "modified"]
+        residual, jacobian = self.stage_equations(t0, h, split)
+        guess = self._predict(h)
+        out = self._solve(residual, jacobian, guess.ravel())
+        if not out.converged and split[0]:
+            # the one-stiffness matrix can be too crude where the nodes differ much: retry with the exact one
+            split[0] = False
+            self.newton.invalidate()
+            out = self._solve(residual, jacobian, guess.ravel())
+            self.newton.invalidate()       # the next step starts again from the split matrix
+        if not out.converged:
+            return StepOutcome.failure(f"Newton: {out.message}")
+        Y = out.x.reshape(n, _S)
+        t1 = t0 + h
+        q1 = q0 + (h * v0 + Y @ co.q_end)
+        v1 = v0 + Y[:, 0] / h
+        # The acceleration at t1 (interpolation, the next step's first guess): M a1 = -r(t1, q1, v1, 0).
+        a1 = self._Mlu.solve(-np.asarray(model.residual(t1, q1, v1, np.zeros_like(q1)), dtype=float))
+        if not np.all(np.isfinite(a1)):
+            return StepOutcome.failure(f"the acceleration at t = {t1:.9g} is not finite (the model's residual there)")
+        self._prev = (h, Y)
+        quad = None
+        if self.want_quadrature:     # the loads' rule: the energy balance is exact with it
+            ld = self._loads
+            ts, Q = self._nodes(t0, h, Y, ld)
+            quad = Quadrature(t=ts, q=Q.T, v=(v0[:, None] + (Y @ ld.Wd.T) / h).T, w=h * ld.b)
+        return StepOutcome(ok=True, t=t1, q=q1, v=v1, a=a1, quadrature=quad)
+
+    def _predict(self, h):
+        """The previous step's acceleration polynomial continued (same ``h``), else ``Y = (h^2 a, 0)``."""
+        if self._prev is not None and self._prev[0] == h:
+            return self._prev[1] @ self._co.predictor.T
+        Y = np.zeros((self.n_dof, _S))
+        Y[:, 0] = (h * h) * self.a
+        return Y

@@ -1,0 +1,213 @@
+"""The energy-preserving collocation HBVM(k, 2) against Lobatto IIIA-3, energy-momentum and its compositions.
+
+``python -m benchmarks.energy_collocation wp --problem B2-4 [--t-end 4] [--out DIR]``
+    work-precision on B2 (``B2-4``, ``B2-8``: 4 or 8 BE2D) or B3 (``B3-8``, ``B3-16``: SQ3D, default
+    structural formulation; ``B3-8c``: continuum): every method over its steps, error eps_T of the tip
+    (``(int_0^T |x_B - x_B,ref|^2 dt)^(1/2)``, all components, samples every 20 ms) against a reference
+    run of energy-collocation at a quarter of its finest step (or ``--h-ref``), process CPU time, Newton iterations per
+    step, the energy's spread after the load relative to the energy; then the CPU time at equal
+    eps_T (log-log interpolation along each method's sweep, no extrapolation) and its ratio to
+    Lobatto IIIA-3's. Runs are cached as JSON in ``--out`` (rerun to complete a sweep).
+``python -m benchmarks.energy_collocation long [--steps 10000] [--elements 1]``
+    energy drift over ``--steps`` free steps (h = 10 ms) after a short load, every constant-mass
+    element and formulation (as ``tests/integrators/test_energy_collocation.py`` with fewer steps).
+``python -m benchmarks.energy_collocation stages [--problem B3-8] [--h 1e-2] [--t-end 10]``
+    the energy's spread after the load against the number of silent stages ``k``.
+
+Lobatto IIIA-3 runs with the chapter's Newton settings (modified, relative tolerance 1e-8), the
+energy-conserving methods with their own (round-off). One run per configuration (a shared machine:
+read ratios, not absolute times).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ancfdae import EnergyMonitor, simulate
+from ancfdae.integrators import NewtonOptions
+from ancfdae.studies._flying import T_HAT, T_PULSE, b2_beam, b3_beam
+
+from ._composition import SUZUKI, TRIPLE_JUMP, ComposedEnergyMomentum
+
+DT_OUT = 0.02
+PROBLEMS = {
+    "B2-4": (lambda: b2_beam("BE2D", 4), T_PULSE),
+    "B2-8": (lambda: b2_beam("BE2D", 8), T_PULSE),
+    "B3-8": (lambda: b3_beam("SQ3D", 8), T_HAT),
+    "B3-16": (lambda: b3_beam("SQ3D", 16), T_HAT),
+    "B3-8c": (lambda: b3_beam("SQ3D", 8, formulation="continuum"), T_HAT),
+}
+#: method label -> steps of its sweep
+SWEEP_B2 = {"lobatto3": (1e-2, 5e-3, 2.5e-3), "energy-collocation": (2e-2, 1e-2, 5e-3, 2.5e-3),
+            "energy-collocation-exact": (1e-2, 5e-3), "energy-momentum": (5e-3, 2.5e-3),
+            "em-suzuki": (1e-2, 5e-3), "em-triple-jump": (1e-2,)}
+SWEEP_B3 = {"lobatto3": (5e-3, 2.5e-3, 1.25e-3), "energy-collocation": (1e-2, 5e-3, 2.5e-3),
+            "energy-collocation-exact": (5e-3,), "energy-momentum": (5e-3,)}
+
+
+def method_of(label, model, h):
+    """``simulate`` keyword arguments of a method label."""
+    if label == "lobatto3":
+        return dict(method="lobatto3", h=h, newton=NewtonOptions(tol=1e-8, jacobian="modified"))
+    if label == "energy-collocation":
+        return dict(method="energy-collocation", h=h)
+    if label == "energy-collocation-exact":
+        return dict(method="energy-collocation", h=h, iteration_matrix="exact")
+    if label.startswith("energy-collocation-k"):
+        return dict(method="energy-collocation", h=h, silent_stages=int(label.rsplit("k", 1)[1]))
+    if label == "energy-momentum":
+        return dict(method="energy-momentum", h=h)
+    if label in ("em-suzuki", "em-triple-jump"):
+        return dict(method=ComposedEnergyMomentum(model, h, SUZUKI if label == "em-suzuki" else TRIPLE_JUMP))
+    raise ValueError(f"unknown method label {label!r}")
+
+
+def run_one(problem, label, h, t_end, out: Path, force=False):
+    """One run (cached): tip history, energy after the load, CPU time, Newton work."""
+    path = out / f"{problem}_{label}_{h:.6g}_{t_end:g}.json"
+    if path.exists() and not force:
+        return json.loads(path.read_text())
+    build, t_load = PROBLEMS[problem]
+    model = build()
+    t_eval = np.round(np.arange(0.0, t_end + 1e-9, DT_OUT), 10)
+    kw = method_of(label, model, h)
+    c0 = time.process_time()
+    res = simulate(model, (0.0, t_end), t_eval=t_eval, monitors=[EnergyMonitor()], **kw)
+    cpu = time.process_time() - c0
+    tip = np.array([model.position(q, 0.0) for q in res.q])
+    total = np.asarray(res.monitors["energy"]["total"])
+    after = res.t >= t_load - 1e-9
+    e_after = total[after]
+    st = res.stats
+    rec = dict(problem=problem, method=label, h=h, t_end=t_end, ok=bool(res.success), message=res.message,
+               t=res.t.tolist(), tip=tip.tolist(), cpu=cpu, steps=int(st["steps"]),
+               its=st.get("newton_iterations", 0) / max(st["steps"], 1),
+               lu=st.get("factorizations", 0) / max(st["steps"], 1),
+               dE=float(np.ptp(e_after) / np.abs(e_after).max()) if e_after.size > 1 else float("nan"))
+    out.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(rec))
+    return rec
+
+
+def eps(run, ref):
+    """``(int |tip - tip_ref|^2 dt)^(1/2)`` over the common samples (trapezoidal rule)."""
+    t, tr = np.asarray(run["t"]), np.asarray(ref["t"])
+    n = min(t.size, tr.size)
+    d = np.asarray(run["tip"])[:n] - np.asarray(ref["tip"])[:n]
+    e2 = np.sum(d * d, axis=1)
+    return float(np.sqrt(np.sum(0.5 * (e2[1:] + e2[:-1]) * np.diff(t[:n]))))
+
+
+def equal_accuracy(rows):
+    """CPU at Lobatto IIIA-3's eps_T levels, log-log interpolated per method; ratio to Lobatto's."""
+    curves = {}
+    for r in rows:
+        if r["ok"] and r["eps"] > 0:
+            curves.setdefault(r["method"], []).append((r["eps"], r["cpu"]))
+    curves = {m: sorted(v) for m, v in curves.items() if len(v) >= 2}
+
+    def cpu_at(m, e):
+        pts = curves.get(m)
+        if not pts:
+            return float("nan")
+        E, C = np.log([p[0] for p in pts]), np.log([p[1] for p in pts])
+        if np.log(e) < E.min() - 1e-9 or np.log(e) > E.max() + 1e-9:
+            return float("nan")
+        return float(np.exp(np.interp(np.log(e), E, C)))
+
+    others = [m for m in curves if m != "lobatto3"]
+    print(f"\nCPU s at equal eps_T (ratio to Lobatto IIIA-3; '-': outside the method's sweep)")
+    print(f"{'eps_T':>10} {'lobatto3':>9} " + " ".join(f"{m:>26}" for m in others))
+    for e, base in curves.get("lobatto3", []):
+        cells = []
+        for m in others:
+            c = cpu_at(m, e)
+            cells.append(f"{'-':>26}" if not np.isfinite(c) else f"{c:>17.1f} ({c / base:4.2f}x)")
+        print(f"{e:>10.2e} {base:>9.1f} " + " ".join(cells))
+
+
+def work_precision(a):
+    sweep = SWEEP_B2 if a.problem.startswith("B2") else SWEEP_B3
+    if a.methods:
+        sweep = {m: sweep[m] for m in a.methods}
+    t_end = a.t_end
+    h_ref = a.h_ref or min(sweep.get("energy-collocation", (2.5e-3,))) / 4
+    for m in sweep:                                # compile every kernel before the timed runs
+        model = PROBLEMS[a.problem][0]()
+        simulate(model, (0.0, 0.05), **method_of(m, model, 1e-2), monitors=[EnergyMonitor()])
+    print(f"{a.problem}, [0, {t_end:g}] s; reference: energy-collocation, h = {h_ref:g}", flush=True)
+    ref = run_one(a.problem, "energy-collocation", h_ref, t_end, a.out)
+    if not ref["ok"]:
+        raise SystemExit(f"reference failed: {ref['message']}")
+    hs = sorted({h for v in sweep.values() for h in v}, reverse=True)
+    rows = []
+    for h in hs:                                  # interleaved: every method at one step, then the next step
+        for m, steps in sweep.items():
+            if h in steps:
+                r = run_one(a.problem, m, h, t_end, a.out)
+                r["eps"] = eps(r, ref) if r["ok"] else float("nan")
+                rows.append(r)
+                print(f"{m:<26}{h:>9.3g}{'ok' if r['ok'] else 'FAILED':>7}{r['eps']:>11.2e}{r['cpu']:>9.1f}"
+                      f"{r['its']:>7.2f}{r['lu']:>7.3f}{r['dE']:>10.1e}" + ("" if r["ok"] else f"  {r['message']}"),
+                      flush=True)
+    equal_accuracy(rows)
+
+
+def long_runs(a):
+    from ancfdae import Material, PointForce, PointMoment, RectangularSection, hat, models, pulse
+    mat, sec = Material(E=1e5, nu=0.3, rho=2500.0), RectangularSection(0.05)
+    cases = [("BE2D", {}), ("BE2D", {"formulation": "continuum"}), ("Cable3D", {}), ("SQ2D", {}),
+             ("SQ2D", {"formulation": "continuum"}), ("SQ2D", {"formulation": "continuum-locking"}),
+             ("SQ3D", {}), ("SQ3D", {"formulation": "continuum"})]
+    h = 1e-2
+    for name, kw in cases:
+        el = getattr(models, name)(mat, sec, **kw)
+        if name.endswith("2D"):
+            t_load, f = 0.3, pulse(0.3)
+            loads = [PointMoment(0.24, node=0, time=f), PointForce((0.24, 0.0), node=0, time=f)]
+            beam = models.Beam(el, a.elements, 1.0, start=(0.0, 0.0), direction=(0.6, 0.8), loads=loads)
+        else:
+            t_load = 0.4
+            beam = models.Beam(el, a.elements, 1.0, start=(0.0, 0.0, 0.0), direction=(0.6, 0.8, 0.0),
+                               loads=[PointMoment((0.1, 0.05, 0.2), node=0, time=hat(t_load / 2))])
+        c0 = time.process_time()
+        res = simulate(beam, (0.0, t_load + a.steps * h), "energy-collocation", h=h)
+        E = np.array([beam.energy(t, q, v).total for t, q, v in zip(res.t, res.q, res.v) if t >= t_load - 1e-12])
+        print(f"{name:<8}{kw.get('formulation', 'default'):<18}k = {res.options['silent_stages']}  "
+              f"{'ok' if res.success else 'FAILED'}  free steps {E.size - 1}  "
+              f"max|E - E0|/|E| = {np.ptp(E) / np.abs(E).max():.2e}  "
+              f"its/step {res.stats['newton_iterations'] / res.stats['steps']:.2f}  "
+              f"CPU {time.process_time() - c0:.0f} s", flush=True)
+
+
+def stages(a):
+    for k in a.k:
+        r = run_one(a.problem, f"energy-collocation-k{k}", a.h, a.t_end, a.out)
+        print(f"{a.problem} h = {a.h:g} k = {k}: {'ok' if r['ok'] else 'FAILED ' + r['message']}, energy spread "
+              f"after the load {r['dE']:.2e} (relative), {r['its']:.2f} its/step, CPU {r['cpu']:.1f} s", flush=True)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("what", choices=("wp", "long", "stages"))
+    ap.add_argument("--problem", default="B2-4", choices=tuple(PROBLEMS))
+    ap.add_argument("--methods", nargs="+", default=None)
+    ap.add_argument("--t-end", type=float, default=None)
+    ap.add_argument("--h", type=float, default=1e-2)
+    ap.add_argument("--k", type=int, nargs="+", default=[4, 5, 6])
+    ap.add_argument("--steps", type=int, default=10_000)
+    ap.add_argument("--elements", type=int, default=1)
+    ap.add_argument("--h-ref", type=float, default=None, help="step of the reference run (default: a quarter of the finest)")
+    ap.add_argument("--out", type=Path, default=Path("out/energy_collocation"))
+    a = ap.parse_args(argv)
+    if a.t_end is None:
+        a.t_end = 4.0 if a.problem.startswith("B2") else 5.0
+    {"wp": work_precision, "long": long_runs, "stages": stages}[a.what](a)
+
+
+if __name__ == "__main__":
+    main()

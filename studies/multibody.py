@@ -1,0 +1,180 @@
+"""Flexible multibody benchmarks B5-B7 with every integrator that handles constraints.
+
+B5 spin-up of a flexible beam (Simo & Vu-Quoc 1986), B6 flexible slider-crank and B7 flexible spatial pendulum
+with a spinning rigid payload (:mod:`ancfdae.studies._multibody_models`), each run by every registered
+integrator that declares ``handles_constraints`` at a sequence of steps, and once by generalized-alpha at a
+step ``refine`` times finer: the reference of the same model. Per run: the error of every output of the
+benchmark against the reference (largest over the outputs, relative to the reference's largest value), the
+position drift ``max |g|`` and the velocity drift ``max |G v + g_t|`` over the outputs, on B7 the energy error
+``max |E - E0|`` relative to the largest kinetic energy and the drift of the angular momentum about the
+vertical, the CPU time; per integrator the observed orders of the outputs (least-squares slopes of log error
+against log step).
+
+Run: ``ancfdae study multibody [--quick] [--out DIR] [--jobs N]``.
+"""
+from __future__ import annotations
+
+import os
+import sys
+import time
+
+import numpy as np
+
+from ancfdae.simulate import METHODS
+
+from ._cli import Option, main as cli_main
+from ._common import Case, OptionError, output_dir, run_cases, settings
+from ._multibody_models import BUILDERS
+from ._tables import cell, errors_note, markdown_table
+
+__all__ = ["run", "run_case", "FULL", "QUICK", "CLI_OPTIONS", "constrained_methods"]
+
+#: benchmark -> (element, elements, builder options)
+MODELS = {"B5": ("BE2D", 8, {"w_s": 4.0}), "B6": ("BE2D", 8, {}), "B7": ("Cable3D", 4, {"E": 5.0e7})}
+#: options per method (beyond h)
+OPTIONS = {"hht": {"alpha": 0.05}, "generalized-alpha": {"rho_inf": 0.8}}
+
+FULL = dict(benchmarks=tuple(MODELS), integrators=None, steps={"B5": (0.1, 0.05, 0.025), "B6": (4e-4, 2e-4, 1e-4),
+            "B7": (0.02, 0.01, 0.005)}, t_end={"B5": 30.0, "B6": 0.5, "B7": 5.0}, refine=4, n_out=51)
+QUICK = dict(steps={"B5": (0.1, 0.05), "B6": (4e-4, 2e-4), "B7": (0.02, 0.01)},
+             t_end={"B5": 4.0, "B6": 0.05, "B7": 0.2}, refine=2, n_out=11)
+CLI_OPTIONS = [
+    Option("benchmarks", str, "benchmarks", nargs="+", choices=tuple(MODELS)),
+    Option("integrators", str, "integrators (default: every method that handles constraints)", nargs="+"),
+]
+
+
+def constrained_methods() -> list[str]:
+    """The registered methods that run constrained models (``handles_constraints``)."""
+    return [m for m, cls in METHODS.items() if getattr(cls, "handles_constraints", False)]
+
+
+def _benchmark(name: str, t_end: float):
+    element, n, opts = MODELS[name]
+    opts = dict(opts, t_end=t_end) if name == "B7" else opts
+    return BUILDERS[name](element, n, **opts)
+
+
+def run_case(case: dict) -> dict:
+    """One run: ``case = {benchmark, integrator, h, t_end, n_out}``."""
+    os.environ.setdefault("OMP_NUM_THREADS", "1")
+    from ancfdae import simulate
+    b = _benchmark(case["benchmark"], case["t_end"])
+    t_eval = np.linspace(0.0, case["t_end"], case["n_out"])
+    t0 = time.process_time()
+    res = simulate(b.system, (0.0, case["t_end"]), case["integrator"], h=case["h"], t_eval=t_eval,
+                   **OPTIONS.get(case["integrator"], {}))
+    return {"result": res, "cpu": time.process_time() - t0, **case}
+
+
+def outputs(record: dict) -> dict:
+    """The benchmark's outputs, the constraint drift and (B7) the invariants of a stored run."""
+    res = record["result"]
+    b = _benchmark(record["benchmark"], record["t_end"])
+    s = b.system
+    out = {k: np.asarray(f(res.t, res.q, res.v, res.lam)) for k, f in b.outputs.items()}
+    g = np.array([s.constraints(t, q) for t, q in zip(res.t, res.q)])
+    gv = np.array([s.constraint_jacobian(t, q) @ v + s.constraint_rates(t, q, v)[0]
+                   for t, q, v in zip(res.t, res.q, res.v)])
+    rec = {k: v for k, v in record.items() if k != "result"}
+    rec.update(t=res.t, out=out, status=res.status, message=res.message,
+               drift_q=float(np.abs(g).max()) if g.size else float("nan"),
+               drift_v=float(np.abs(gv).max()) if gv.size else float("nan"))
+    if "energy" in out and res.t.size:
+        T = np.array([s.energy(t, q, v).kinetic for t, q, v in zip(res.t, res.q, res.v)])
+        rec["energy_error"] = float(np.abs(out["energy"] - out["energy"][0]).max() / T.max())
+        L = out["angular_momentum_z"]
+        rec["momentum_error"] = float(np.abs(L - L[0]).max() / abs(L[0]))
+    return rec
+
+
+def _error(rec, ref) -> float:
+    """Largest output error against the reference, each relative to the reference's largest value."""
+    if rec["t"].size != ref["t"].size:
+        return float("nan")
+    errs = [np.abs(rec["out"][k] - ref["out"][k]).max() / max(np.abs(ref["out"][k]).max(), 1e-300)
+            for k in ref["out"] if k not in ("energy", "angular_momentum_z")]
+    return float(max(errs))
+
+
+def run(benchmarks=None, integrators=None, steps=None, t_end=None, refine=None, n_out=None, quick: bool = False,
+        out=None, jobs: int | None = None, executor=None, plots: bool = True, progress: bool = True) -> dict:
+    """Run the study. Options left None take :data:`FULL` (:data:`QUICK` with ``quick``).
+
+    Parameters
+    ----------
+    benchmarks : sequence of str
+        Of ``B5``, ``B6``, ``B7``.
+    integrators : sequence of str, optional
+        Default: :func:`constrained_methods`.
+    steps, t_end : dict
+        Steps and end time per benchmark.
+    refine : int
+        The reference runs generalized-alpha at the finest step divided by ``refine``.
+    n_out : int
+        Output times (equally spaced, both ends included).
+    quick, out, jobs, executor, plots, progress
+        The sweep options of every study (:mod:`ancfdae.studies._common`).
+
+    Returns
+    -------
+    dict
+        ``rows`` (one per run: error, drifts, invariants, CPU), ``orders`` (per benchmark and integrator) and
+        the keys of every study.
+    """
+    o = settings(FULL, QUICK, quick, dict(benchmarks=benchmarks, integrators=integrators, steps=steps,
+                                          t_end=t_end, refine=refine, n_out=n_out))
+    methods = list(o["integrators"] or constrained_methods())
+    unknown = [m for m in methods if m not in constrained_methods()]
+    if unknown or not methods:
+        raise OptionError(f"`integrators` must name methods that handle constraints {constrained_methods()}, "
+                          f"got {methods}.")
+    path = output_dir("multibody", out, quick) if (plots or out is not None) else None
+    cases = []
+    for bm in o["benchmarks"]:
+        base = {"benchmark": bm, "t_end": o["t_end"][bm], "n_out": o["n_out"]}
+        h_ref = min(o["steps"][bm]) / o["refine"]
+        cases.append(Case(dict(base, integrator="generalized-alpha", h=h_ref, reference=True),
+                          label=f"{bm} reference h={h_ref:g}", cost=base["t_end"] / h_ref))
+        cases += [Case(dict(base, integrator=m, h=h, reference=False), label=f"{bm} {m} h={h:g}",
+                       cost=base["t_end"] / h) for m in methods for h in o["steps"][bm]]
+    sweep = run_cases(run_case, cases, out=path, executor=executor, jobs=jobs, reduce=outputs, name="multibody",
+                      progress=progress, cost=lambda c: c["cost"])
+    records = sweep.finished()
+    refs = {r["benchmark"]: r for r in records if r["reference"]}
+    rows = []
+    for r in records:
+        if r["reference"] or r["benchmark"] not in refs:
+            continue
+        rows.append({k: r.get(k) for k in ("benchmark", "integrator", "h", "status", "cpu", "drift_q", "drift_v",
+                                            "energy_error", "momentum_error")} | {"error": _error(r, refs[r["benchmark"]])})
+    orders = {}
+    for bm in o["benchmarks"]:
+        for m in methods:
+            pts = [(r["h"], r["error"]) for r in rows if r["benchmark"] == bm and r["integrator"] == m
+                   and np.isfinite(r["error"]) and r["error"] > 0]
+            if len(pts) >= 2:
+                h, e = np.log(np.array(pts)).T
+                orders[(bm, m)] = float(np.polyfit(h, e, 1)[0])
+    table = _table(rows, orders, refs, sweep.errors)
+    if plots:
+        (path / "multibody.md").write_text("# Flexible multibody benchmarks B5-B7\n\n" + table)
+    return {"rows": rows, "orders": orders, "references": refs, "records": records, "errors": sweep.errors,
+            "reused": sweep.reused, "figures": {}, "table": table, "path": path}
+
+
+def _table(rows, orders, refs, errors) -> str:
+    headers = ["benchmark", "integrator", "h (s)", "status", "error vs reference", "order", "max |g|",
+               "max |G v + g_t|", "energy error (B7)", "L_z drift (B7)", "CPU (s)"]
+    body = [[r["benchmark"], r["integrator"], f"{r['h']:g}", r["status"], cell(r["error"], ".2e"),
+             cell(orders.get((r["benchmark"], r["integrator"])), ".2f"), cell(r["drift_q"], ".1e"),
+             cell(r["drift_v"], ".1e"), cell(r["energy_error"], ".1e"), cell(r["momentum_error"], ".1e"),
+             f"{r['cpu']:.1f}"] for r in rows]
+    text = "References: generalized-alpha (rho_inf 0.8) at " + ", ".join(
+        f"{bm} h = {r['h']:g} s" for bm, r in refs.items()) + ". Errors: largest over the outputs, each relative " \
+        "to the reference's largest value; order: slope of log error against log h.\n\n"
+    return text + markdown_table(headers, body) + errors_note(errors)
+
+
+if __name__ == "__main__":     # python -m ancfdae.studies.multibody: the same as `ancfdae study multibody`
+    raise SystemExit(cli_main(sys.modules[__name__]))

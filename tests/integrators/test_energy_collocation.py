@@ -1,0 +1,194 @@
+"""The energy-preserving collocation HBVM(k, 2) (``"energy-collocation"``): order 4 and exact energy.
+
+Beams of B2/B3 revision 2 (``support.flying_beams``, as for the energy-momentum tests), the spring chain of the
+toy models (the constant-mass order problem of the energy-momentum tests).
+"""
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from ancfdae import simulate
+from ancfdae.integrators import EnergyCollocation
+from ancfdae.integrators._hbvm_coefficients import hbvm_coefficients, legendre01
+from ancfdae.integrators.energy_collocation import _SplitMatrix
+from ancfdae.integrators._linsolve import factorize
+from ancfdae.monitors import EnergyMonitor
+from ancfdae.problem import JacobianBlocks
+from support.flying_beams import CASES, b2, b3, momenta, total_energy
+from support.toy_models import SpringChain
+
+
+def run(model, h, t_end, monitor=None, **options):
+    res = simulate(model, (0.0, t_end), "energy-collocation", h=h, monitors=[monitor] if monitor else (), **options)
+    assert res.success, res.message
+    return res
+
+
+def test_coefficients():
+    """Catches: a wrong X (closed form of Brugnano et al.), projection, predictor or midpoint row."""
+    for k in (2, 3, 4, 6):
+        co = hbvm_coefficients(k, 2)
+        xi = 1.0 / (2.0 * np.sqrt(3.0))
+        assert np.abs(co.X - [[0.5, -xi], [xi, 0.0]]).max() <= 1e-15
+        assert np.abs(co.C.sum(axis=2) - co.X @ co.X).max() <= 1e-14       # frozen K -> X^2
+        assert np.abs(co.b @ co.c ** (2 * k - 1) - 1.0 / (2 * k)).max() <= 1e-14   # Gauss: degree 2k - 1
+    co = hbvm_coefficients(4, 2)
+    # a linear acceleration a(c) = 1 + 2 c (units of h^2): its Legendre coefficients and the end/mid positions
+    Y = np.array([[2.0, 2.0 / (2 * np.sqrt(3.0))]])          # P_0 coefficient 2, P_1 coefficient 1/sqrt(3)
+    pos = lambda c: c ** 2 / 2 + c ** 3 / 3                   # int_0^c int_0^x (1 + 2 y) dy dx
+    assert (Y @ co.q_end)[0] == pytest.approx(pos(1.0), abs=1e-15)
+    assert (Y @ co.mid)[0] == pytest.approx(pos(0.5), abs=1e-15)
+    # continued over the next step: a(1 + c) = 3 + 2 c
+    assert np.abs(Y @ co.predictor.T - [[4.0, 2.0 / (2 * np.sqrt(3.0))]]).max() <= 1e-14
+    assert legendre01(1)(1.0) == pytest.approx(np.sqrt(3.0))
+    with pytest.raises(ValueError, match="`k`"):
+        hbvm_coefficients(1, 2)
+
+
+def _stepper(model, h=2e-2, **kw):
+    st = EnergyCollocation(model, h, **kw)
+    q, v = model.initial_state()
+    rng = np.random.default_rng(3)
+    q = q + 1e-2 * rng.standard_normal(q.size)
+    v = v + 0.1 * rng.standard_normal(v.size)
+    st.initialize(model, 0.2, q, v, np.zeros_like(q), 1.0)
+    return st, rng
+
+
+@pytest.mark.parametrize("name, kw", [("BE2D", {}), ("SQ3D", {"formulation": "continuum"})])
+def test_exact_jacobian_matches_finite_differences(name, kw):
+    """Block by block against central differences of the stage residual (loads on at t = 0.2 s).
+
+    Catches: a wrong weight C[i, m, l], a stiffness taken at the wrong node, a missing M / h^2.
+    """
+    model = b2(name, 1, **kw) if name.endswith("2D") else b3(name, 1, **kw)
+    st, rng = _stepper(model)
+    residual, jacobian = st.stage_equations(st.t, st.h, [False])
+    x = 1e-3 * rng.standard_normal(2 * model.n_dof)
+    J = jacobian(x)[0].toarray()
+    eps = 1e-6
+    Jfd = np.column_stack([(residual(x + eps * e) - residual(x - eps * e)) / (2 * eps) for e in np.eye(x.size)])
+    n = model.n_dof
+    for i in range(2):
+        for m in range(2):
+            blk, ref = J[i::2, m::2], Jfd[i::2, m::2]
+            assert np.abs(blk - ref).max() <= 1e-6 * np.abs(Jfd).max(), (i, m)
+    assert J.shape == (2 * n, 2 * n)
+
+
+def test_split_matrix_is_the_exact_jacobian_with_one_stiffness():
+    """With the same stiffness at every node the eigen-split solve equals the exact Jacobian's.
+
+    Catches: the h^2 scaling of the unknowns, X transposed, damping left in the split matrix.
+    """
+    model = b3("SQ3D", 1, formulation="continuum")
+    st, rng = _stepper(model, h=3e-2)
+    q = st.q
+    z = np.zeros_like(q)
+    blk = model.jacobian(0.3, q, z, z)
+    K = blk.K
+    one = JacobianBlocks(K, sp.csr_matrix((np.zeros_like(K.data), K.indices, K.indptr), shape=K.shape), blk.M, True)
+    r = rng.standard_normal(2 * model.n_dof)
+    zero = one.D
+    exact = factorize(st._assemble([K] * st.silent_stages, [zero, zero], st.h)).solve(r)
+    split = factorize(_SplitMatrix(one, st.h, hbvm_coefficients(st.silent_stages, 2).X)).solve(r)
+    assert np.abs(split - exact).max() <= 1e-10 * np.abs(exact).max()
+
+
+def _differences(runs):
+    """max|x_h - x_{h/2}| of successive runs: ~ C h^p for a method of order p."""
+    return [np.abs(a - b).max() for a, b in zip(runs[:-1], runs[1:])]
+
+
+def test_observed_order_four_spring_chain():
+    """Spring chain with gravity and a pulse force (the energy-momentum order problem): q and v ~ h^4.
+
+    Catches: an order-2 projection (wrong Legendre weights, forces at the wrong nodes, v1 off the polynomial).
+    """
+    model = SpringChain(force=(3.0, -2.0), T=0.5)
+    hs = [1 / 20, 1 / 40, 1 / 80, 1 / 160]
+    res = [run(model, h, 1.0) for h in hs]
+    for x in ("q", "v"):
+        d = _differences([getattr(r, x)[-1] for r in res])
+        slope = np.polyfit(np.log(hs[:-1]), np.log(d), 1)[0]
+        assert abs(slope - 4.0) < 0.2, (x, slope, d)
+
+
+def test_observed_order_four_b2():
+    """B2 with 4 BE2D elements (pulse force and moment on) over [0, 0.2] s: q and v ~ h^4."""
+    model = b2("BE2D", 4)
+    hs = [1e-2, 5e-3, 2.5e-3, 1.25e-3]
+    res = [run(model, h, 0.2, t_eval=[0.2]) for h in hs]
+    for x in ("q", "v"):
+        d = _differences([getattr(r, x)[-1] for r in res])
+        slope = np.polyfit(np.log(hs[:-1]), np.log(d), 1)[0]
+        assert abs(slope - 4.0) < 0.2, (x, slope, d)
+
+
+FREE_STEPS = 120
+
+
+@pytest.mark.parametrize("name, n, kw", [(c[0], 1, c[2]) for c in CASES], ids=lambda c: str(c))
+def test_free_motion_energy_constant_every_element(name, n, kw):
+    """Every constant-mass element and formulation, one element: a short load, then FREE_STEPS steps of
+    10 ms; energy constant to 1e-12 relative at every step (the 10^4-step runs: ``python -m
+    benchmarks.energy_collocation long``).
+
+    Catches: too few silent stages for a formulation ('auto'), a Newton stop above round-off.
+    """
+    t_load = 0.3 if name.endswith("2D") else 0.4
+    beam = b2(name, n, T=t_load, **kw) if name.endswith("2D") else b3(name, n, t_load=t_load, **kw)
+    res = run(beam, 1e-2, t_load + FREE_STEPS * 1e-2)
+    E = total_energy(beam, list(zip(res.t, res.q, res.v)), t_load)
+    assert E.size >= FREE_STEPS
+    assert np.ptp(E) <= 1e-12 * np.abs(E).max(), np.ptp(E) / np.abs(E).max()
+    polynomial = name.startswith("SQ") and "continuum" in kw.get("formulation", "")
+    assert res.options["silent_stages"] == (4 if polynomial else 6)
+
+
+def test_too_few_silent_stages_lose_the_energy():
+    """SQ3D continuum (quartic P) with k = 3 < 4 nodes: the energy is no longer exact (the docstring's rule).
+
+    Catches: a test above that would pass whatever k (a model or load that does not excite the nonlinearity).
+    """
+    drift = {}
+    for k in (3, 4):
+        beam = b3("SQ3D", 1, t_load=0.4, formulation="continuum")
+        res = run(beam, 2e-2, 1.4, silent_stages=k)
+        E = total_energy(beam, list(zip(res.t, res.q, res.v)), 0.4)
+        drift[k] = np.ptp(E) / np.abs(E).max()
+    assert drift[4] <= 1e-12 and drift[3] >= 1e3 * drift[4], drift
+
+
+def test_energy_balance_with_loads_and_linear_momentum():
+    """Under loads T + U + V - W_ext (W_ext by the step's k-node rule, its Quadrature) is constant; under a
+    pure moment the linear momentum stays zero.
+
+    Catches: a quadrature that is not the scheme's (nodes, velocities sigma', weights), loads evaluated off
+    the nodes, internal forces with a resultant.
+    """
+    beam = b2("SQ2D", 2, T=0.5)
+    res = run(beam, 5e-3, 0.5, monitor=EnergyMonitor())
+    log = res.monitors["energy"]
+    assert np.abs(log["work"]).max() > 1e-4
+    assert np.abs(log["drift"]).max() <= 1e-12 * log["scale"], log["relative_drift"]
+    beam = b3("SQ3D", 1, t_load=0.5)
+    res = run(beam, 1e-2, 1.0)
+    p, _ = momenta(beam, list(zip(res.t, res.q, res.v)))
+    scale = np.abs(beam.mass(None) @ res.v[-1]).sum()
+    assert np.abs(p).max() <= 1e-13 * scale, np.abs(p).max() / scale
+
+
+def test_bad_input_refused_with_reason():
+    beam = b2("BE2D", 1)
+    with pytest.raises(ValueError, match="constant mass matrix"):
+        EnergyCollocation(b3("BE3D", 1), 1e-2)
+    for bad in (1, 2.5, "six", True):
+        with pytest.raises(ValueError, match="silent_stages"):
+            EnergyCollocation(beam, 1e-2, silent_stages=bad)
+    with pytest.raises(ValueError, match="iteration_matrix"):
+        EnergyCollocation(beam, 1e-2, iteration_matrix="lu")
+    with pytest.raises(ValueError, match="h"):
+        EnergyCollocation(beam, 0.0)
+    res = simulate(SpringChain(damping=0.5), (0.0, 1.0), "energy-collocation", h=1e-2)
+    assert not res.success and "velocity-dependent" in res.message
