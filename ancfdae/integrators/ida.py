@@ -27,12 +27,12 @@ import scipy.sparse as sp
 from numpy.typing import ArrayLike
 
 from ancfdae import _validate as validate
-from ancfdae.integrators._constraint_terms import consistent_multipliers, constraint_rows
+from ancfdae.constrained import multipliers
 from ancfdae.integrators._ida_jacobian import _JacobianFiller
 from ancfdae.integrators.ida_constrained import GGLResidual
 from ancfdae.integrators.integrator import Integrator
 from ancfdae.integrators.protocol import StepOutcome
-from ancfdae.problem import Model
+from ancfdae.problem import Model, capabilities
 
 __all__ = ["IDA"]
 
@@ -112,6 +112,10 @@ class IDA(Integrator):
     ``update_below`` with IDA. A run that starts at rest under a load that starts from zero
     has a stationary initial state: IDA's first step then scales with the span (a run over
     [0, 1e6] s stepped over a 3 s load); give ``max_step`` for long spans.
+
+    Constrained models (capability ``"constraints"``): the GGL form ``y = [q, v, lam, mu]`` with the
+    multipliers out of the error test (:mod:`ancfdae.integrators.ida_constrained`, which says why and
+    what it costs: the constraints hold to about the position tolerance).
 
     Statistics: ``newton_iterations`` counts calls of the residual, which SUNDIALS' Newton
     solver evaluates exactly once per iteration (the Jacobian is ours, no difference
@@ -214,7 +218,7 @@ class IDA(Integrator):
         self._reinits = 0
         self._replay = False
         self._ggl = None
-        if constraint_rows(self.model):
+        if "constraints" in capabilities(self.model):
             self._setup_constrained()
             return
         blocks0 = self.model.jacobian(t0, q0, v0, a0)
@@ -249,7 +253,7 @@ class IDA(Integrator):
     def _setup_constrained(self) -> None:
         """The GGL form (:mod:`ancfdae.integrators.ida_constrained`) with consistent ``(a0, lam0)``."""
         if self.lam is None:     # no multipliers given: (a0, lam0) from the KKT system
-            self.a, self.lam = consistent_multipliers(self.model, self.t, self.q, self.v)
+            self.a, self.lam = multipliers(self.model, self.t, self.q, self.v)
         ls = self._ls
         self._ggl = ggl = GGLResidual(self.model, self.t, self.q, self.v, self.a, self.lam, ls)
         self._perm = None
@@ -321,7 +325,7 @@ class IDA(Integrator):
         """
         super().restart(t, q, v, a, model)
         if self._ggl is not None:    # multipliers consistent with the changed state (and a with them)
-            self.a, self.lam = consistent_multipliers(self.model, self.t, q, v)
+            self.a, self.lam = multipliers(self.model, self.t, q, v)
             a = self.a
         self._solver.init_step(float(t), *self._join(q, v, a))
         self._replay = False

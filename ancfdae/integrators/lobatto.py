@@ -39,7 +39,7 @@ import scipy.sparse as sp
 from ancfdae import _validate as validate
 from ancfdae.integrators._affine import affine2, stage_constants, stage_states
 from ancfdae.integrators._linsolve import StageMatrix
-from ancfdae.integrators._constraint_terms import consistent_multipliers, constraint_rows
+from ancfdae.constrained import multipliers
 from ancfdae.integrators._newton_records import NewtonOptions
 from ancfdae.integrators.lobatto_constrained import GGLStages, ggl_step
 from ancfdae.integrators.newton_stepper import NewtonStepper
@@ -156,6 +156,14 @@ class LobattoIIIA(NewtonStepper):
         depends on the contraction rate, not on the initial residual: on
         the 25-element BE2D pendulum (h = 1e-4) "extrapolate" took 5.0
         instead of 4.7 iterations per step.
+
+    Notes
+    -----
+    A model with the ``"constraints"`` capability is integrated in the stabilised index-2 (GGL) form
+    with a reduced stage system (:mod:`ancfdae.integrators.lobatto_constrained`): order 4 in q and v
+    on linear, quadratic and rheonomic constraints, ``g`` and ``G v + g_t`` held at every step to the
+    Newton tolerance; the step's multipliers are returned in ``StepOutcome.lam`` (the predictor is
+    always "constant" there).
     """
 
     handles_constraints = True
@@ -202,10 +210,23 @@ class LobattoIIIA(NewtonStepper):
         self._w_cache = None
         self._stages = "residual_stages" in capabilities(self.model)   # declared, forwarded by the proxy
         self._ggl = None
-        if constraint_rows(self.model):   # constrained: the GGL stage system (lobatto_constrained)
+        if "constraints" in capabilities(self.model):   # constrained: the GGL stage system (lobatto_constrained)
             if self.lam is None:          # no multipliers given: (a0, lam0) from the KKT system
-                self.a, self.lam = consistent_multipliers(self.model, self.t, self.q, self.v)
+                self.a, self.lam = multipliers(self.model, self.t, self.q, self.v)
             self._ggl = GGLStages(self)
+
+    def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model) -> None:
+        """After a model event; a constrained model gets ``(a, lam)`` consistent with the changed state (the
+        first stage of the next step is ``a``).
+
+        Parameters
+        ----------
+        t, q, v, a, model
+            As for :meth:`~ancfdae.integrators.FixedStepIntegrator.restart`.
+        """
+        super().restart(t, q, v, a, model)
+        if self._ggl is not None:
+            self.a, self.lam = multipliers(self.model, self.t, self.q, self.v)
 
     # -- predictor -------------------------------------------------------------------------
     def _guess(self, h):
