@@ -190,7 +190,7 @@ class EnergyMomentum(NewtonStepper):
         self._constrained = "constraints" in capabilities(self.model)
         if self._constrained:
             self._mscale = mass_scale(self._M)
-            self._kkt = KKTAssembler()
+            self._kkt, self._kkt_out = KKTAssembler(), KKTAssembler()
             if self.lam is None:
                 self.lam = np.zeros(self.model.n_constraints)
 
