@@ -149,6 +149,9 @@ class EnergyMomentum(NewtonStepper):
                              "potential, potential_gradient, nonconservative_force) for method "
                              f"'energy-momentum'; {type(model).__name__} declares "
                              f"{sorted(capabilities(model))}.")
+        if "constraints" in capabilities(model) and not getattr(model, "mass_is_constant", False):
+            raise ValueError("`model` with constraints must have a constant mass matrix for method "
+                             "'energy-momentum' (its constrained step uses M; mass_is_constant=False given).")
         if "constraints" in capabilities(model) and getattr(model, "constraint_degree", None) not in (1, 2):
             raise ValueError("`model` constraints must be at most quadratic in q (constraint_degree 1 or 2) for "
                              "method 'energy-momentum', whose midpoint constraint Jacobian is then an exact "
