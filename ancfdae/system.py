@@ -72,7 +72,6 @@ class System(BodyStack):
             [f"body {self.bodies.index(b)}: {lab}" for b, _, m in self._body_rows
              for lab in getattr(b, "constraint_labels", [f"row {i}" for i in range(m)])]
             + list(self._joint_set.labels))
-        self.rheonomic = self._joint_set.rheonomic or any(getattr(b, "rheonomic", True) for b, _, _ in self._body_rows)
         if self.n_constraints:
             drop = dependent_rows(self.constraint_jacobian(t0, q0))
             if drop:

@@ -141,8 +141,8 @@ def _constrained_start(stepper, model, caps, events, t0, q0, v0):
     if not getattr(stepper, "handles_constraints", False):
         raise TypeError(f"method {name!r} cannot integrate constrained models ({type(model).__name__} declares "
                         f"'constraints', {model.n_constraints} rows): its stepper does not declare "
-                        "handles_constraints = True. Use 'generalized-alpha', 'hht', 'newmark' or "
-                        "'energy-momentum', or eliminate the supports instead of joining them.")
+                        "handles_constraints = True. Use a built-in method (ancfdae.METHODS), or eliminate the "
+                        "supports instead of joining them.")
     if events:
         raise ValueError(f"{type(model).__name__} has both constraints and an event state ('step_events'); "
                          "the driver does not carry constraints across model events yet.")

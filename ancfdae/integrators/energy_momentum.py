@@ -144,6 +144,9 @@ class EnergyMomentum(NewtonStepper):
                  newton: NewtonOptions | dict | None = None) -> None:
         self.variable_mass = not getattr(model, "mass_is_constant", False)
         require_potential_model(model, "energy-momentum", variable_mass=True)
+        if "constraints" in capabilities(model) and self.variable_mass:
+            raise ValueError("`model` with constraints must have a constant mass matrix for method "
+                             "'energy-momentum' (its constrained step uses M; mass_is_constant=False given).")
         if "constraints" in capabilities(model) and getattr(model, "constraint_degree", None) not in (1, 2):
             raise ValueError("`model` constraints must be at most quadratic in q (constraint_degree 1 or 2) for "
                              "method 'energy-momentum', whose midpoint constraint Jacobian is then an exact "
@@ -188,7 +191,7 @@ class EnergyMomentum(NewtonStepper):
         self._constrained = "constraints" in capabilities(self.model)
         if self._constrained:
             self._mscale = mass_scale(self._M)
-            self._kkt = KKTAssembler()
+            self._kkt, self._kkt_out = KKTAssembler(), KKTAssembler()
             if self.lam is None:
                 self.lam = np.zeros(self.model.n_constraints)
 
