@@ -63,6 +63,20 @@ def test_a_folded_element_is_flagged(steel, square):
     assert any("element(s) [1] folded" in w for w in _static_checks.plausibility(beam, q))
 
 
+@pytest.mark.parametrize("stretch, flagged", [(1.05, False), (1.09, False), (1.12, True), (0.85, True), (1.3, True)])
+def test_the_strain_threshold_is_on_the_axial_strain(steel, square, stretch, flagged):
+    """Catches a threshold on the wrong quantity (the stretch instead of the strain, a shifted bound): a beam
+    stretched uniformly by a factor (x and x' scaled) is flagged exactly when |stretch - 1| > 0.1."""
+    beam = _b1(steel, square, 2)
+    full = beam.expand(beam.initial_state()[0]).reshape(beam.n_nodes, -1).copy()
+    full[:, [0, 2]] *= stretch                       # BE2D node coordinates (x, y, x', y')
+    q = full.reshape(-1)[beam.free]
+    warnings = _static_checks.plausibility(beam, q)
+    assert bool(warnings) == flagged, warnings
+    if flagged:
+        assert f"stretch {stretch:.4g}" in warnings[0]
+
+
 @pytest.mark.parametrize("seed", range(6))
 def test_inertia_counts_the_negative_eigenvalues(seed):
     """Catches a wrong count from the sparse factorisation (pivoting, 2x2 blocks): random sparse symmetric
@@ -75,6 +89,14 @@ def test_inertia_counts_the_negative_eigenvalues(seed):
     n_neg, n_zero, how = _static_checks.inertia(sp.csr_matrix(A))
     assert (n_neg, n_zero) == (want, 0), how
     assert _static_checks._dense(A) == (want, 0)
+
+
+def test_inertia_of_a_saddle_point_matrix_with_zero_diagonal():
+    """Catches counting the pivots of a factorisation that pivoted rows (a zero diagonal forces it; its
+    diagonal of U is then not the D of L D L^T): [[0, I], [I, 0]] has n negative and n positive eigenvalues."""
+    n = 10
+    A = sp.bmat([[None, sp.eye(n)], [sp.eye(n), None]]).tocsr()
+    assert _static_checks.inertia(A)[:2] == (n, 0)
 
 
 def test_bad_starts_name_the_argument(steel, square):
