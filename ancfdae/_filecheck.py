@@ -26,6 +26,7 @@ __all__ = ["CHECKSUM_ATTR", "encoding", "checksums", "verify"]
 #: Global attribute holding the JSON ``{item: sha256 prefix}`` of :func:`checksums`.
 CHECKSUM_ATTR = "checksums"
 _HEX = 24          # hex digits kept per item (96 bits: a chance collision is out of reach)
+_CHUNK_BYTES = 1 << 20     # HDF5 chunks of up to 1 MiB (its default chunk cache; the limit is 4 GiB)
 
 
 def _numeric(dtype) -> bool:
@@ -38,7 +39,22 @@ def encoding(ds) -> dict:
     Text variables are left out: HDF5 applies no filter to variable-length strings (netCDF4 ignores
     the request, h5netcdf refuses it); :func:`checksums` covers them.
     """
-    return {name: {"fletcher32": True} for name, var in ds.variables.items() if _numeric(var.dtype)}
+    # one chunk per variable (up to _CHUNK_BYTES per chunk): the default chunking of a filtered variable
+    # splits a 16 MB array into many small chunks, each with its own index entry and checksum
+    out = {}
+    for name, var in ds.variables.items():
+        if _numeric(var.dtype):
+            out[name] = {"fletcher32": True, "chunksizes": _chunks(var.shape, var.dtype.itemsize)}
+    return out
+
+
+def _chunks(shape, itemsize) -> tuple:
+    """Whole rows per chunk, as many as fit in _CHUNK_BYTES (at least one entry along every axis)."""
+    shape = tuple(max(1, int(n)) for n in shape)
+    if not shape:
+        return ()
+    row = itemsize * int(np.prod(shape[1:], dtype=np.int64))
+    return (max(1, min(shape[0], _CHUNK_BYTES // max(row, 1))),) + shape[1:]
 
 
 def _plain(value):

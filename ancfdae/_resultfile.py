@@ -23,7 +23,10 @@ Every numeric variable carries HDF5's Fletcher-32 checksum and the global attrib
 description (``n_dof``, the coordinate labels, the mesh). A damaged file raises
 :class:`ResultFileError` naming the file and the variable or attribute, never loads other values.
 Files are written to a temporary name in the target folder and renamed, so a killed writer leaves
-no half file under the final name. Format-2 files (no checksums) are still read.
+no half file under the final name. Format-2 files (no checksums) are still read. Cost, measured
+(``python benchmarks/result_checksums.py 10000 200 5``, medians of interleaved runs on the shared
+machine): for 10,000 outputs x 200 coordinates, write 1.22 s against 0.48 s without checksums,
+read 1.13 s against 0.58 s, 4.8 % larger (chunks of 1 MiB); for 200 x 50, 1.5 and 1.4 times.
 
 Engine
 ------
