@@ -19,6 +19,7 @@ import sys
 from pathlib import Path
 
 from . import __version__
+from . import _validate as validate
 from .export import vtk
 from .plot import animate
 from .result import Result, ResultFileError
@@ -85,6 +86,10 @@ def _export(args) -> int:
 
 
 def _animate(args) -> int:
+    try:
+        validate.output_file("path", args.output, (".gif",))    # before the (slow) load and drawing
+    except ValueError as exc:
+        raise _user_error("animate", exc) from None
     result = _load_result(args.result)
     try:
         out = animate(result, args.output, every=args.every, fps=args.fps)

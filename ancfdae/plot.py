@@ -230,6 +230,9 @@ def animate(result: Result, path: str | os.PathLike, *, beam: Beam | RigidBody |
     pathlib.Path
         The file written. Frames share fixed axis limits (those of the whole motion).
     """
+    path = validate.output_file("path", path, (".gif",))     # checked first: a bad path fails at once
+    fps = validate.positive_int("fps", fps)
+    dpi = validate.positive_int("dpi", dpi)
     from matplotlib.animation import PillowWriter       # matplotlib on first use, as in _new_axes
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
@@ -238,9 +241,6 @@ def animate(result: Result, path: str | os.PathLike, *, beam: Beam | RigidBody |
         raise ValueError(f"`every` must be a positive integer, got {every!r}.")
     if result.t.size == 0:
         raise ValueError("`result` has no outputs to animate.")
-    fps = validate.positive_int("fps", fps)
-    dpi = validate.positive_int("dpi", dpi)
-    path = validate.output_file("path", path, (".gif",))
     parts = bodies_of(result, beam)
     frames = range(0, result.t.size, every)
     fig = Figure(figsize=(6, 4))
