@@ -25,7 +25,7 @@ def square():
 #: seconds a test may take (wall clock) before it fails; ANCFDAE_TEST_TIMEOUT overrides it (0: no guard).
 #: Generous: see tests/README.md for the slowest tests measured; a cold numba cache adds the compilation of
 #: a whole element family to its first test.
-TEST_TIMEOUT = float(os.environ.get("ANCFDAE_TEST_TIMEOUT", "600"))
+TEST_TIMEOUT = float(os.environ.get("ANCFDAE_TEST_TIMEOUT", "1200"))
 
 
 class TestTimeout(Exception):
