@@ -30,6 +30,7 @@ from __future__ import annotations
 import numbers
 
 from ancfdae.integrators._affine import affine2, affine3, newmark_predict
+from ancfdae.integrators._alpha_iteration import AlphaIteration
 from ancfdae.integrators._newton_records import NewtonOptions
 from ancfdae.integrators.newton_stepper import NewtonStepper
 from ancfdae.integrators.protocol import StepOutcome
@@ -83,12 +84,24 @@ class _AlphaFamily(NewtonStepper):
             J = model.jacobian(ta, qa, va, aa)
             return J.combine(cqa, cva, caa), self.floor_of(J.K, qa)
 
-        out = self._solve(residual, jacobian, self.a)
+        iterate = self._compiled_iteration(ta, qa0, va0, aa0, cqa, cva, caa)
+        out = self._solve(residual, jacobian, self.a, iterate=iterate)
         if not out.converged:
             return StepOutcome.failure(f"Newton: {out.message}")
         x = out.x
         q, v = affine2(q_pred, v_pred, cq, cv, x)
         return StepOutcome(ok=True, t=t + h, q=q, v=v, a=x)
+
+    def _compiled_iteration(self, ta, qa0, va0, aa0, cqa, cva, caa):
+        """The step's iteration as one compiled call (:mod:`._alpha_iteration`) when the model offers a compiled
+        residual (:meth:`ancfdae.models.Beam.compiled_residual`) and Newton is modified; else None."""
+        if self.newton.options.jacobian != "modified":
+            return None
+        offer = getattr(self.model.wrapped, "compiled_residual", None)
+        compiled = offer() if offer is not None else None
+        if compiled is None:
+            return None
+        return AlphaIteration(compiled, self.model, ta, qa0, va0, aa0, cqa, cva, caa)
 
 
 class Newmark(_AlphaFamily):

@@ -28,6 +28,7 @@ from ...problem import Energy, JacobianBlocks
 from ..element import Element
 from . import checks, describe as description, mesh
 from .assembly import Assembler
+from .compiled import compiled_residual
 from .loads import LoadSet, load_sequence
 from .potential import symmetry_generators
 from .stages import StageEvaluator
@@ -88,9 +89,8 @@ class Beam:
 
     Notes
     -----
-    Also a :class:`ancfdae.problem.PotentialModel` (``potential``,
-    ``potential_gradient``, ``nonconservative_force``, ``symmetry_generators``)
-    when its mass is constant.
+    Also a :class:`ancfdae.problem.PotentialModel` (``potential``, ``potential_gradient``,
+    ``nonconservative_force``, ``symmetry_generators``) when its mass is constant.
     """
 
     def __init__(self, element: Element, n_elements: int | None = None, length: float | None = None,
@@ -141,12 +141,9 @@ class Beam:
 
     @classmethod
     def from_description(cls, model: dict) -> Beam:
-        """The beam of a :meth:`describe` dict (e.g. ``Result.model`` of a result file), without its loads.
-
-        Same element, material, section, nodes and supports, hence the same
-        coordinates and reference configuration; see
-        :func:`~ancfdae.models.beam.describe.beam_arguments` for the errors.
-        """
+        """The beam of a :meth:`describe` dict (e.g. ``Result.model`` of a result file), without its loads:
+        same element, material, section, nodes and supports, hence the same coordinates and reference
+        configuration; see :func:`~ancfdae.models.beam.describe.beam_arguments` for the errors."""
         element, kwargs = description.beam_arguments(model)
         return cls(element, **kwargs)
 
@@ -364,6 +361,11 @@ class Beam:
         else:
             F_ext = np.column_stack([self._f_external(ts[i], Q[:, i], False)[0] for i in range(m)])
         return self._stages.residuals(Q, A, F_ext, float(self.load_factor))
+
+    def compiled_residual(self):
+        """The residual as compiled pieces for an integrator's compiled Newton iterations, or None
+        (:func:`.compiled.compiled_residual`)."""
+        return compiled_residual(self)
 
     # -- the potential capability (ancfdae.problem.PotentialModel) ---------
     @property

@@ -1,0 +1,71 @@
+"""The shared parts of compiled Newmark-family Newton iterations (needs numba).
+
+An element's compiled kernel may offer an *iterations* entry point besides its fused one
+(:func:`ancfdae.models.beam.compiled.compiled_residual`)::
+
+    iterations(x, r, err, max_k, contraction, threshold, lub, kl, ku, piv, qa0, va0, aa0, cqa, cva, caa,
+               lam, f_ext, q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices, rbuf, kdata,
+               *element_args) -> (x, r, max|dx|, err_new, err_prev, k)
+
+Each iteration is ``dx = J^-1 r`` from LAPACK's banded factors ``(lub, kl, ku, piv)``, ``x <- x - dx``
+and the residual ``f(q) + M a - lam f_ext`` at the weighted state ``(qa0 + cqa x, va0 + cva x,
+aa0 + caa x)`` of the Newmark family (:mod:`ancfdae.integrators.newmark`): :func:`alpha_update`,
+the element's fused call, :func:`alpha_finish`. The loop goes on while an iteration is one in which
+:class:`ancfdae.integrators._newton.NewtonSolver` would simply carry on -- finite, not converged
+(``err_new > threshold``), contracting (``err_new / err <= contraction`` and ``err_new <= err / 2``,
+so no round-off stagnation test can fire) -- for at most ``max_k`` iterations; it returns the state
+after the last iteration, the error before it and the number of iterations ``k`` (after a non-finite
+correction, ``x`` and ``r`` before it), and the solver takes that iteration's decision in Python.
+The element calls its fused kernel by name, a compile-time constant, so numba caches the loop on disk
+(a numba function passed as an argument, or a closure over one, costs some 50 us of dispatch per call
+or a fresh compilation in every process); see
+:func:`ancfdae.models.thin.be2d_numba.be2d_alpha_iterations`.
+"""
+from __future__ import annotations
+
+from numba import njit
+
+from ...integrators._affine import affine3
+from ...integrators._linsolve_numba import band_solve
+from .assembly_numba import finish_residual
+
+__all__ = ["alpha_update", "alpha_finish", "carry_on"]
+
+
+@njit(cache=True)
+def _max_abs(x):
+    """``max|x|``, NaN if any entry is NaN (as :func:`ancfdae.integrators._newton.max_abs`)."""
+    m = 0.0
+    for v in x:
+        a = abs(v)
+        if a != a:
+            return a
+        if a > m:
+            m = a
+    return m
+
+
+@njit(cache=True)
+def alpha_update(x, r, lub, kl, ku, piv, qa0, va0, aa0, cqa, cva, caa):
+    """``(x - dx, q, v, a, max|dx|)``: the correction ``dx = J^-1 r`` and the weighted state of ``x - dx``."""
+    dx = r.copy()
+    band_solve(lub, kl, ku, piv, dx)
+    xn = x - dx
+    q, v, a = affine3(qa0, va0, aa0, cqa, cva, caa, xn)
+    return xn, q, v, a, _max_abs(dx)
+
+
+@njit(cache=True)
+def alpha_finish(xn, rbuf, m_data, indptr, indices, a, lam, f_ext, dx_max):
+    """``(xn, r, dx_max, max|r|)`` with ``r = rbuf + M a - lam f_ext`` (``rbuf``: the fused kernel's forces)."""
+    finish_residual(rbuf, m_data, indptr, indices, a, lam, f_ext)
+    rn = rbuf[:xn.size].copy()
+    return xn, rn, dx_max, _max_abs(rn)
+
+
+@njit(cache=True)
+def carry_on(err_new, err, threshold, contraction):
+    """True when the solver would carry on after this iteration without a decision (module docstring)."""
+    if not (err_new > threshold) or err_new != err_new:
+        return False
+    return err_new / err <= contraction and not (err_new > 0.5 * err)
