@@ -17,6 +17,9 @@ import numpy as np
 
 __all__ = ["AlphaIteration"]
 
+_NO_LU = np.zeros((2, 2), order="F")   # the band factors' types (Fortran order), for a residual-only call
+_NO_PIV = np.zeros(1, dtype=np.int32)
+
 
 class AlphaIteration:
     """The compiled iterations of one Newmark-family step, the step's constants bound.
@@ -41,6 +44,11 @@ class AlphaIteration:
                       compiled.external(ta)) + compiled.arrays
         self._tail = (np.empty(qa0.size + 1), np.empty(1)) + compiled.element_args
         self._counter = counter
+
+    def residual(self, x):
+        """The residual at ``x`` (the solver's first evaluation), compiled, counted."""
+        self._counter.n_residual += 1
+        return self._fn(x, x, 0.0, 0, 0.0, 0.0, _NO_LU, 0, 0, _NO_PIV, *self._args, *self._tail)[1]
 
     def __call__(self, x, r, lu, err, max_k, contraction, threshold):
         """``(x, r, max|dx|, err_new, err_prev, k)`` after ``k`` compiled iterations, or None when ``lu`` has no

@@ -53,6 +53,11 @@ class _AlphaFamily(NewtonStepper):
     def __init__(self, model, h, beta, gamma, alpha_m, alpha_f, newton):
         super().__init__(model, h, newton=newton)
         self.beta, self.gamma, self.alpha_m, self.alpha_f = beta, gamma, alpha_m, alpha_f
+        self._offer = (None, None)   # (model, its compiled_residual), taken at the first step of a run
+
+    def _setup(self) -> None:
+        super()._setup()
+        self._offer = (None, None)
 
     def options(self) -> dict:
         """The options as a JSON-able dict (stored in the Result).
@@ -85,7 +90,7 @@ class _AlphaFamily(NewtonStepper):
             return J.combine(cqa, cva, caa), self.floor_of(J.K, qa)
 
         iterate = self._compiled_iteration(ta, qa0, va0, aa0, cqa, cva, caa)
-        out = self._solve(residual, jacobian, self.a, iterate=iterate)
+        out = self._solve(residual if iterate is None else iterate.residual, jacobian, self.a, iterate=iterate)
         if not out.converged:
             return StepOutcome.failure(f"Newton: {out.message}")
         x = out.x
@@ -97,8 +102,11 @@ class _AlphaFamily(NewtonStepper):
         residual (:meth:`ancfdae.models.Beam.compiled_residual`) and Newton is modified; else None."""
         if self.newton.options.jacobian != "modified":
             return None
-        offer = getattr(self.model.wrapped, "compiled_residual", None)
-        compiled = offer() if offer is not None else None
+        model = self.model.wrapped
+        if self._offer[0] is not model:   # the model's offer, once per run and bound model
+            offer = getattr(model, "compiled_residual", None)
+            self._offer = (model, offer() if offer is not None else None)
+        compiled = self._offer[1]
         if compiled is None:
             return None
         return AlphaIteration(compiled, self.model, ta, qa0, va0, aa0, cqa, cva, caa)

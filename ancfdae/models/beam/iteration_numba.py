@@ -16,6 +16,7 @@ the element's fused call, :func:`alpha_finish`. The loop goes on while an iterat
 so no round-off stagnation test can fire) -- for at most ``max_k`` iterations; it returns the state
 after the last iteration, the error before it and the number of iterations ``k`` (after a non-finite
 correction, ``x`` and ``r`` before it), and the solver takes that iteration's decision in Python.
+With ``max_k = 0`` it evaluates the residual at ``x`` alone (``lub``, ``piv`` unused; ``k = 0``).
 The element calls its fused kernel by name, a compile-time constant, so numba caches the loop on disk
 (a numba function passed as an argument, or a closure over one, costs some 50 us of dispatch per call
 or a fresh compilation in every process); see

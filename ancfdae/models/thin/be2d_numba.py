@@ -17,6 +17,7 @@ import numpy as np
 from numba import njit
 
 from ..beam.assembly_numba import gather_elements, scatter
+from ...integrators._affine import affine3
 from ..beam.iteration_numba import alpha_finish, alpha_update, carry_on
 from ..element import Kernel
 
@@ -166,6 +167,11 @@ def be2d_alpha_iterations(x, r, err, max_k, contraction, threshold, lub, kl, ku,
                           caa, lam, f_ext, q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices, rbuf,
                           kdata, dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4):
     """Newmark-family Newton iterations in one call (contract in :mod:`ancfdae.models.beam.iteration_numba`)."""
+    if max_k == 0:   # the residual at x alone
+        q, v, a = affine3(qa0, va0, aa0, cqa, cva, caa, x)
+        be2d_fused(q, q_fixed, gather, vec_slot, mat_slot, False, rbuf, kdata,
+                   dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4)
+        return alpha_finish(x, rbuf, m_data, indptr, indices, a, lam, f_ext, 0.0) + (err, 0)
     k = 0
     while True:
         xn, q, v, a, dx_max = alpha_update(x, r, lub, kl, ku, piv, qa0, va0, aa0, cqa, cva, caa)
