@@ -48,16 +48,19 @@ class AlphaIteration:
     def residual(self, x):
         """The residual at ``x`` (the solver's first evaluation), compiled, counted."""
         self._counter.n_residual += 1
-        return self._fn(x, x, 0.0, 0, 0.0, 0.0, _NO_LU, 0, 0, _NO_PIV, *self._args, *self._tail)[1]
+        r = np.empty(x.size)
+        self._fn(x, r, 0.0, 0, 0.0, 0.0, _NO_LU, 0, 0, _NO_PIV, *self._args, *self._tail)
+        return r
 
     def __call__(self, x, r, lu, err, max_k, contraction, threshold):
-        """``(x, r, max|dx|, err_new, err_prev, k)`` after ``k`` compiled iterations, or None when ``lu`` has no
-        compiled real substitution (see :meth:`ancfdae.integrators._newton.NewtonSolver.solve`)."""
+        """``(max|dx|, err_new, err_prev, k)`` after ``k`` compiled iterations that update ``x`` and ``r`` in
+        place, or None when ``lu`` has no compiled real substitution (see
+        :meth:`ancfdae.integrators._newton.NewtonSolver.solve`)."""
         lub = getattr(lu, "lub", None)
         if lub is None or not lu._compiled or lu.dtype != np.float64:
             return None
         out = self._fn(x, r, float(err), int(max_k), float(contraction), float(threshold), lub, lu.kl, lu.ku,
                        lu.piv, *self._args, *self._tail)
         # the Python iteration evaluates no residual after a non-finite correction
-        self._counter.n_residual += out[5] if math.isfinite(out[2]) else out[5] - 1
+        self._counter.n_residual += out[3] if math.isfinite(out[0]) else out[3] - 1
         return out

@@ -184,9 +184,9 @@ class NewtonSolver:
             saves the second pass (B1 with BE2D: about a fifth of the solve).
             Ignored by modified Newton, which seldom needs the Jacobian.
         iterate : callable, optional
-            ``iterate(x, r, factor, err, max_k, contraction, threshold) -> (x, r, max|dx|, err_new,
-            err_prev, k)`` or None when it cannot use ``factor``: ``k >= 1`` iterations as one compiled
-            call, on while this loop would carry on without a decision (contract in
+            ``iterate(x, r, factor, err, max_k, contraction, threshold) -> (max|dx|, err_new, err_prev, k)``
+            or None when it cannot use ``factor``: ``k >= 1`` iterations as one compiled call that updates
+            ``x`` and ``r`` in place, on while this loop would carry on without a decision (contract in
             :mod:`ancfdae.models.beam.iteration_numba`; :mod:`ancfdae.integrators._alpha_iteration`);
             modified Newton only.
 
@@ -244,6 +244,8 @@ class NewtonSolver:
         full = opts.jacobian == "full"
         stale = self._lu is not None and not full
         x = x0.copy()
+        if iterate is not None:
+            r = r.copy()   # compiled iterations update r in place; the caller's r starts a retry
         err0 = err = max_abs(r)
         rel = max(opts.tol * err0, atol)
         threshold = max(rel, floor)
@@ -261,21 +263,19 @@ class NewtonSolver:
                 fresh = True
                 threshold = max(rel, floor)  # a new matrix may bring a new floor
             step = (iterate(x, r, self._lu._lu, err, opts.max_iter - k + 1, opts.contraction, threshold)
-                    if iterate is not None else None)
+                    if iterate is not None else None)   # x, r: this attempt's own arrays
             if step is not None:
-                # compiled iterations up to the one that needs a decision (iterate's docstring)
-                x_step, r_step, dx_max, err_new, err, n = step
+                # compiled iterations, x and r in place, up to the one that needs a decision (iterate's docstring)
+                dx_max, err_new, err, n = step
                 self.stats.iterations += n
                 k += n - 1
                 if n > 1:
                     diverging = 0   # the iterations before the last one contracted
                 finite = math.isfinite(dx_max)
                 self.stats.residual_evals += n if finite else n - 1
-                x = x_step
                 if not finite:
                     return NewtonOutcome(x, False, k, err, "Newton correction is not finite "
                                          "(singular iteration matrix?)", floor), stale
-                r = r_step
             else:
                 dx = self._lu.solve(r)   # the correction is -dx (negation commutes exactly with the solve)
                 self.stats.iterations += 1

@@ -5,18 +5,19 @@ An element's compiled kernel may offer an *iterations* entry point besides its f
 
     iterations(x, r, err, max_k, contraction, threshold, lub, kl, ku, piv, qa0, va0, aa0, cqa, cva, caa,
                lam, f_ext, q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices, rbuf, kdata,
-               *element_args) -> (x, r, max|dx|, err_new, err_prev, k)
+               *element_args) -> (max|dx|, err_new, err_prev, k)
 
 Each iteration is ``dx = J^-1 r`` from LAPACK's banded factors ``(lub, kl, ku, piv)``, ``x <- x - dx``
 and the residual ``f(q) + M a - lam f_ext`` at the weighted state ``(qa0 + cqa x, va0 + cva x,
 aa0 + caa x)`` of the Newmark family (:mod:`ancfdae.integrators.newmark`): :func:`alpha_update`,
-the element's fused call, :func:`alpha_finish`. The loop goes on while an iteration is one in which
+the element's fused call, :func:`alpha_finish`; ``x`` and ``r`` are updated in place (no array is
+returned: boxing one costs a few microseconds). The loop goes on while an iteration is one in which
 :class:`ancfdae.integrators._newton.NewtonSolver` would simply carry on -- finite, not converged
 (``err_new > threshold``), contracting (``err_new / err <= contraction`` and ``err_new <= err / 2``,
-so no round-off stagnation test can fire) -- for at most ``max_k`` iterations; it returns the state
-after the last iteration, the error before it and the number of iterations ``k`` (after a non-finite
-correction, ``x`` and ``r`` before it), and the solver takes that iteration's decision in Python.
-With ``max_k = 0`` it evaluates the residual at ``x`` alone (``lub``, ``piv`` unused; ``k = 0``).
+so no round-off stagnation test can fire) -- for at most ``max_k`` iterations; it returns the error
+after the last iteration and before it and the number of iterations ``k`` (after a non-finite
+correction, ``x`` and ``r`` are those before it), and the solver takes that iteration's decision in
+Python. With ``max_k = 0`` it writes the residual at ``x`` into ``r`` (``lub``, ``piv`` unused; ``k = 0``).
 The element calls its fused kernel by name, a compile-time constant, so numba caches the loop on disk
 (a numba function passed as an argument, or a closure over one, costs some 50 us of dispatch per call
 or a fresh compilation in every process); see
@@ -24,6 +25,7 @@ or a fresh compilation in every process); see
 """
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
 from ...integrators._affine import affine3
@@ -48,20 +50,25 @@ def _max_abs(x):
 
 @njit(cache=True)
 def alpha_update(x, r, lub, kl, ku, piv, qa0, va0, aa0, cqa, cva, caa):
-    """``(x - dx, q, v, a, max|dx|)``: the correction ``dx = J^-1 r`` and the weighted state of ``x - dx``."""
+    """``(q, v, a, max|dx|)``: the correction ``dx = J^-1 r``, ``x <- x - dx`` in place (only when ``dx`` is
+    finite) and the weighted state of the new ``x``."""
     dx = r.copy()
     band_solve(lub, kl, ku, piv, dx)
-    xn = x - dx
-    q, v, a = affine3(qa0, va0, aa0, cqa, cva, caa, xn)
-    return xn, q, v, a, _max_abs(dx)
+    dx_max = _max_abs(dx)
+    if dx_max == dx_max and dx_max != np.inf:
+        for i in range(x.size):
+            x[i] = x[i] - dx[i]
+    q, v, a = affine3(qa0, va0, aa0, cqa, cva, caa, x)
+    return q, v, a, dx_max
 
 
 @njit(cache=True)
-def alpha_finish(xn, rbuf, m_data, indptr, indices, a, lam, f_ext, dx_max):
-    """``(xn, r, dx_max, max|r|)`` with ``r = rbuf + M a - lam f_ext`` (``rbuf``: the fused kernel's forces)."""
+def alpha_finish(r, rbuf, m_data, indptr, indices, a, lam, f_ext):
+    """``max|r|`` after ``r <- rbuf + M a - lam f_ext`` in place (``rbuf``: the fused kernel's forces)."""
     finish_residual(rbuf, m_data, indptr, indices, a, lam, f_ext)
-    rn = rbuf[:xn.size].copy()
-    return xn, rn, dx_max, _max_abs(rn)
+    for i in range(r.size):
+        r[i] = rbuf[i]
+    return _max_abs(r)
 
 
 @njit(cache=True)

@@ -171,18 +171,18 @@ def be2d_alpha_iterations(x, r, err, max_k, contraction, threshold, lub, kl, ku,
         q, v, a = affine3(qa0, va0, aa0, cqa, cva, caa, x)
         be2d_fused(q, q_fixed, gather, vec_slot, mat_slot, False, rbuf, kdata,
                    dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4)
-        return alpha_finish(x, rbuf, m_data, indptr, indices, a, lam, f_ext, 0.0) + (err, 0)
+        return 0.0, alpha_finish(r, rbuf, m_data, indptr, indices, a, lam, f_ext), err, 0
     k = 0
     while True:
-        xn, q, v, a, dx_max = alpha_update(x, r, lub, kl, ku, piv, qa0, va0, aa0, cqa, cva, caa)
+        q, v, a, dx_max = alpha_update(x, r, lub, kl, ku, piv, qa0, va0, aa0, cqa, cva, caa)
         k += 1
         if not np.isfinite(dx_max):
-            return x, r, dx_max, err, err, k
+            return dx_max, err, err, k
         be2d_fused(q, q_fixed, gather, vec_slot, mat_slot, False, rbuf, kdata,
                    dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4)
-        x, r, dx_max, err_new = alpha_finish(xn, rbuf, m_data, indptr, indices, a, lam, f_ext, dx_max)
+        err_new = alpha_finish(r, rbuf, m_data, indptr, indices, a, lam, f_ext)
         if k >= max_k or not carry_on(err_new, err, threshold, contraction):
-            return x, r, dx_max, err_new, err, k
+            return dx_max, err_new, err, k
         err = err_new
 
 
