@@ -122,8 +122,12 @@ def _peer_settings(integrator, h, t_end, tol):
 
 def run_peer(n, integrator, h, t_end, tol):
     """One timed Exudyn run (ObjectBeamGeometricallyExact, modified Newton, adaptive step off)."""
-    (SC, mbs, tip), _, _, cpus = timed_solves(lambda: _build_peer(n), lambda: _peer_settings(integrator, h, t_end, tol),
-                                              _exu.MainSolverImplicitSecondOrder, 1, "SolveSystem failed")
+    try:
+        (SC, mbs, tip), _, _, cpus = timed_solves(lambda: _build_peer(n),
+                                                  lambda: _peer_settings(integrator, h, t_end, tol),
+                                                  _exu.MainSolverImplicitSecondOrder, 1, "SolveSystem failed")
+    except RuntimeError as exc:   # a failed solve is a failed run (a reference's failure ends the benchmark)
+        return dict(cpu=float("nan"), tip=None, t=np.zeros(0), ok=False, message=str(exc))
     d = np.asarray(mbs.GetSensorStoredData(tip))
     out = dict(cpu=cpus[0], tip=d[:, 1:4], t=d[:, 0], ok=True, message="")
     if not covers(out, t_end, h):   # Exudyn may stop early and still return True

@@ -28,7 +28,7 @@ from ...problem import Energy, JacobianBlocks
 from ..element import Element
 from . import checks, describe as description, mesh
 from .assembly import Assembler
-from .compiled import compiled_residual
+from .compiled import CompiledResidual, compiled_residual
 from .loads import LoadSet, load_sequence
 from .potential import symmetry_generators
 from .stages import StageEvaluator
@@ -362,7 +362,7 @@ class Beam:
             F_ext = np.column_stack([self._f_external(ts[i], Q[:, i], False)[0] for i in range(m)])
         return self._stages.residuals(Q, A, F_ext, float(self.load_factor))
 
-    def compiled_residual(self):
+    def compiled_residual(self) -> CompiledResidual | None:
         """The residual as compiled pieces for an integrator's compiled Newton iterations, or None
         (:func:`.compiled.compiled_residual`)."""
         return compiled_residual(self)
