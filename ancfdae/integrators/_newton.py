@@ -150,6 +150,7 @@ class NewtonSolver:
         floor: float = 0.0,
         floor_update: str = "max",
         residual_jacobian: Callable[[np.ndarray], tuple] | None = None,
+        iterate: Callable | None = None,
     ) -> NewtonOutcome:
         """Iterate from ``x0`` until the residual test passes.
 
@@ -182,6 +183,12 @@ class NewtonSolver:
             point, so a model that computes both from one kernel evaluation
             saves the second pass (B1 with BE2D: about a fifth of the solve).
             Ignored by modified Newton, which seldom needs the Jacobian.
+        iterate : callable, optional
+            ``iterate(x, r, factor, err, max_k, contraction, threshold) -> (max|dx|, err_new, err_prev, k)``
+            or None when it cannot use ``factor``: ``k >= 1`` iterations as one compiled call that updates
+            ``x`` and ``r`` in place, on while this loop would carry on without a decision (contract in
+            :mod:`ancfdae.models.beam.iteration_numba`; :mod:`ancfdae.integrators._alpha_iteration`);
+            modified Newton only.
 
         Returns
         -------
@@ -205,7 +212,9 @@ class NewtonSolver:
         if not math.isfinite(max_abs(r)):
             self.stats.failed_solves += 1
             return NewtonOutcome(x0, False, 0, float("nan"), "residual at the initial guess is not finite", floor)
-        outcome, stale = self._attempt(residual, jacobian, x0, r, residual_atol, floor, keep_max, fused, J)
+        if fused is not None:
+            iterate = None
+        outcome, stale = self._attempt(residual, jacobian, x0, r, residual_atol, floor, keep_max, fused, J, iterate)
         if (not outcome.converged and stale and self.options.jacobian == "modified"
                 and self.options.retry):
             # The failed attempt started from a matrix of an earlier solve:
@@ -213,7 +222,8 @@ class NewtonSolver:
             self.stats.retries += 1
             self.invalidate()
             first = outcome
-            retry, _ = self._attempt(residual, jacobian, x0, r, residual_atol, first.floor, keep_max)
+            retry, _ = self._attempt(residual, jacobian, x0, r, residual_atol, first.floor, keep_max,
+                                     iterate=iterate)
             outcome = NewtonOutcome(retry.x, retry.converged, first.iterations + retry.iterations,
                                     retry.residual_norm,
                                     retry.message if retry.converged else
@@ -223,16 +233,19 @@ class NewtonSolver:
             self.stats.failed_solves += 1
         return outcome
 
-    def _attempt(self, residual, jacobian, x0, r, atol, floor, keep_max, fused=None, J=None):
+    def _attempt(self, residual, jacobian, x0, r, atol, floor, keep_max, fused=None, J=None, iterate=None):
         """One Newton attempt; returns (outcome, started_with_stale_matrix).
 
         With ``fused`` (full Newton and a ``residual_jacobian``), ``J`` is the
         Jacobian evaluated with ``r``, and every new residual brings its own.
+        With ``iterate``, an iteration is one compiled call where the factor allows it.
         """
         opts = self.options
         full = opts.jacobian == "full"
         stale = self._lu is not None and not full
         x = x0.copy()
+        if iterate is not None:
+            r = r.copy()   # compiled iterations update r in place; the caller's r starts a retry
         err0 = err = max_abs(r)
         rel = max(opts.tol * err0, atol)
         threshold = max(rel, floor)
@@ -240,25 +253,42 @@ class NewtonSolver:
             return NewtonOutcome(x, True, 0, err, "converged at the initial guess", floor), stale
         fresh = False  # the cached matrix was evaluated during this attempt
         diverging = 0
-        for k in range(1, opts.max_iter + 1):
+        k = 0
+        while k < opts.max_iter:
+            k += 1
             if full or self._lu is None:
                 msg, floor = self._refresh(jacobian, x, J, floor, keep_max)
                 if msg is not None:
                     return NewtonOutcome(x, False, k - 1, err, msg, floor), stale
                 fresh = True
                 threshold = max(rel, floor)  # a new matrix may bring a new floor
-            dx = self._lu.solve(r)   # the correction is -dx (negation commutes exactly with the solve)
-            self.stats.iterations += 1
-            dx_max = max_abs(dx)  # NaN/inf propagate into the max
-            if not math.isfinite(dx_max):   # math: 20x cheaper than np on a float
-                return NewtonOutcome(x, False, k, err, "Newton correction is not finite "
-                                     "(singular iteration matrix?)", floor), stale
-            x = x - dx
-            if fused is not None:
-                r, J = self._eval_fused(fused, x)
+            step = (iterate(x, r, self._lu._lu, err, opts.max_iter - k + 1, opts.contraction, threshold)
+                    if iterate is not None else None)   # x, r: this attempt's own arrays
+            if step is not None:
+                # compiled iterations, x and r in place, up to the one that needs a decision (iterate's docstring)
+                dx_max, err_new, err, n = step
+                self.stats.iterations += n
+                k += n - 1
+                if n > 1:
+                    diverging = 0   # the iterations before the last one contracted
+                finite = math.isfinite(dx_max)
+                self.stats.residual_evals += n if finite else n - 1
+                if not finite:
+                    return NewtonOutcome(x, False, k, err, "Newton correction is not finite "
+                                         "(singular iteration matrix?)", floor), stale
             else:
-                r = self._eval(residual, x)
-            err_new = max_abs(r)
+                dx = self._lu.solve(r)   # the correction is -dx (negation commutes exactly with the solve)
+                self.stats.iterations += 1
+                dx_max = max_abs(dx)  # NaN/inf propagate into the max
+                if not math.isfinite(dx_max):   # math: 20x cheaper than np on a float
+                    return NewtonOutcome(x, False, k, err, "Newton correction is not finite "
+                                         "(singular iteration matrix?)", floor), stale
+                x = x - dx
+                if fused is not None:
+                    r, J = self._eval_fused(fused, x)
+                else:
+                    r = self._eval(residual, x)
+                err_new = max_abs(r)
             if not math.isfinite(err_new):
                 return NewtonOutcome(x, False, k, float("nan"),
                                      f"residual became non-finite at iteration {k}", floor), stale

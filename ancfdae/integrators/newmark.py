@@ -41,6 +41,7 @@ import numpy as np
 from ancfdae.integrators._affine import affine2, affine3, newmark_predict
 from ancfdae.integrators._alpha_index3 import index3_step, mass_scale
 from ancfdae.kkt import KKTAssembler
+from ancfdae.integrators._alpha_iteration import AlphaIteration
 from ancfdae.integrators._newton_records import NewtonOptions
 from ancfdae.integrators.driver import consistent_acceleration
 from ancfdae.integrators.newton_stepper import NewtonStepper
@@ -67,6 +68,11 @@ class _AlphaFamily(NewtonStepper):
     def __init__(self, model, h, beta, gamma, alpha_m, alpha_f, newton):
         super().__init__(model, h, newton=newton)
         self.beta, self.gamma, self.alpha_m, self.alpha_f = beta, gamma, alpha_m, alpha_f
+        self._offer = (None, None)   # (model, its compiled_residual), taken at the first step of a run
+
+    def _setup(self) -> None:
+        super()._setup()
+        self._offer = (None, None)
 
     def options(self) -> dict:
         """The options as a JSON-able dict (stored in the Result).
@@ -148,12 +154,27 @@ class _AlphaFamily(NewtonStepper):
             J = model.jacobian(ta, qa, va, aa)
             return J.combine(cqa, cva, caa), self.floor_of(J.K, qa)
 
-        out = self._solve(residual, jacobian, self.a)
+        iterate = self._compiled_iteration(ta, qa0, va0, aa0, cqa, cva, caa)
+        out = self._solve(residual if iterate is None else iterate.residual, jacobian, self.a, iterate=iterate)
         if not out.converged:
             return StepOutcome.failure(f"Newton: {out.message}")
         x = out.x
         q, v = affine2(q_pred, v_pred, cq, cv, x)
         return StepOutcome(ok=True, t=t + h, q=q, v=v, a=x)
+
+    def _compiled_iteration(self, ta, qa0, va0, aa0, cqa, cva, caa):
+        """The step's iteration as one compiled call (:mod:`._alpha_iteration`) when the model offers a compiled
+        residual (:meth:`ancfdae.models.Beam.compiled_residual`) and Newton is modified; else None."""
+        if self.newton.options.jacobian != "modified":
+            return None
+        model = self.model.wrapped
+        if self._offer[0] is not model:   # the model's offer, once per run and bound model
+            offer = getattr(model, "compiled_residual", None)
+            self._offer = (model, offer() if offer is not None else None)
+        compiled = self._offer[1]
+        if compiled is None:
+            return None
+        return AlphaIteration(compiled, self.model, ta, qa0, va0, aa0, cqa, cva, caa)
 
 
 class Newmark(_AlphaFamily):

@@ -134,14 +134,15 @@ class NewtonStepper(FixedStepIntegrator):
         """
         return roundoff_floor(self.FLOOR_ROUNDOFF, K, q)
 
-    def _solve(self, residual, jacobian, x0) -> NewtonOutcome:
+    def _solve(self, residual, jacobian, x0, iterate=None) -> NewtonOutcome:
         """Newton with the run's absolute tolerance and the floor carried from the earlier solves.
 
-        ``jacobian(x)`` returns ``(matrix, self.floor_of(K, q))``. The outcome has ``x``,
+        ``jacobian(x)`` returns ``(matrix, self.floor_of(K, q))``; ``iterate``: the compiled iteration
+        (see :meth:`NewtonSolver.solve`), or None. The outcome has ``x``,
         ``converged``, ``iterations``, ``residual_norm``, ``message`` and ``floor``.
         """
         out = self.newton.solve(residual, jacobian, x0, residual_atol=self._atol, floor=self._floor,
-                                floor_update=self.FLOOR_UPDATE)
+                                floor_update=self.FLOOR_UPDATE, iterate=iterate)
         self._floor = out.floor
         return out
 

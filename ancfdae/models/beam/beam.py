@@ -7,9 +7,8 @@ share one pattern, so an integrator forms its iteration matrix by combining data
 
 The beam is one class that owns its collaborators, each built once from explicit inputs: the
 :class:`~.assembly.Assembler` (the fixed pattern), the :class:`~.loads.LoadSet` (the loads as free force
-vectors) and the :class:`~.stages.StageEvaluator` (several stages in one element pass). The argument
-checks are the functions of :mod:`.checks`, the mesh those of :mod:`.mesh`, the description those of
-:mod:`.describe`, the rigid motions :func:`.potential.symmetry_generators`.
+vectors) and the :class:`~.stages.StageEvaluator` (several stages in one element pass); argument checks,
+mesh, description, rigid motions: the functions of :mod:`.checks`, :mod:`.mesh`, :mod:`.describe`, :mod:`.potential`.
 """
 from __future__ import annotations
 
@@ -30,6 +29,7 @@ from ..element import Element
 from . import checks, describe as description, mesh
 from .assembly import Assembler
 from .attach import beam_attachment
+from .compiled import compiled_residual
 from .loads import LoadSet, load_sequence
 from .mass_forms import MassForms
 from .potential import symmetry_generators
@@ -91,9 +91,8 @@ class Beam(MassForms):
 
     Notes
     -----
-    Also a :class:`ancfdae.problem.PotentialModel` (``potential``,
-    ``potential_gradient``, ``nonconservative_force``, ``symmetry_generators``)
-    when its mass is constant.
+    Also a :class:`ancfdae.problem.PotentialModel` (``potential``, ``potential_gradient``,
+    ``nonconservative_force``, ``symmetry_generators``) when its mass is constant.
     """
 
     def __init__(self, element: Element, n_elements: int | None = None, length: float | None = None,
@@ -368,6 +367,8 @@ class Beam(MassForms):
             F_ext = np.column_stack([self._f_external(ts[i], Q[:, i], False)[0] for i in range(m)])
         return self._stages.residuals(Q, A, F_ext, float(self.load_factor))
 
+    compiled_residual = compiled_residual   # the residual as compiled pieces, or None (:mod:`.compiled`)
+
     # -- the potential capability (ancfdae.problem.PotentialModel) ---------
     @property
     def potential_degree(self) -> int | None:
@@ -391,10 +392,8 @@ class Beam(MassForms):
         f, kdata = self._load_set.nonconservative(t, self.expand(q), self.geom, tangent)
         if not tangent:
             return self.load_factor * f, None
-        kdata = self._zero_data if kdata is None else kdata
-        return self.load_factor * f, self._asm.csr(self.load_factor * kdata)
+        return self.load_factor * f, self._asm.csr(self.load_factor * (self._zero_data if kdata is None else kdata))
 
     def symmetry_generators(self) -> tuple[np.ndarray, list[sp.csr_matrix]]:
-        """Translations and rotations that leave the strain energy unchanged (free beams only); see
-        :func:`ancfdae.models.beam.potential.symmetry_generators`."""
+        """Translations and rotations that keep the strain energy (free beams only; :mod:`.potential`)."""
         return symmetry_generators(self.element.dim, self.element.n_node_dof, self.n_nodes, self.fixed)

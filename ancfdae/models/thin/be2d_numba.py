@@ -17,9 +17,11 @@ import numpy as np
 from numba import njit
 
 from ..beam.assembly_numba import gather_elements, scatter
+from ...integrators._affine import affine3
+from ..beam.iteration_numba import alpha_finish, alpha_update, carry_on
 from ..element import Kernel
 
-__all__ = ["BE2DCompiled", "be2d_forces", "be2d_fused", "STRUCTURAL", "CONTINUUM"]
+__all__ = ["BE2DCompiled", "be2d_forces", "be2d_fused", "be2d_alpha_iterations", "STRUCTURAL", "CONTINUUM"]
 
 STRUCTURAL, CONTINUUM = 0, 1
 
@@ -160,6 +162,30 @@ def be2d_fused(q, q_fixed, gather, vec_slot, mat_slot, tangent, r, kdata,
         scatter(K, mat_slot, kdata)
 
 
+@njit(cache=True)
+def be2d_alpha_iterations(x, r, err, max_k, contraction, threshold, lub, kl, ku, piv, qa0, va0, aa0, cqa, cva,
+                          caa, lam, f_ext, q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices, rbuf,
+                          kdata, dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4):
+    """Newmark-family Newton iterations in one call (contract in :mod:`ancfdae.models.beam.iteration_numba`)."""
+    if max_k == 0:   # the residual at x alone
+        q, v, a = affine3(qa0, va0, aa0, cqa, cva, caa, x)
+        be2d_fused(q, q_fixed, gather, vec_slot, mat_slot, False, rbuf, kdata,
+                   dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4)
+        return 0.0, alpha_finish(r, rbuf, m_data, indptr, indices, a, lam, f_ext), err, 0
+    k = 0
+    while True:
+        q, v, a, dx_max = alpha_update(x, r, lub, kl, ku, piv, qa0, va0, aa0, cqa, cva, caa)
+        k += 1
+        if not np.isfinite(dx_max):
+            return dx_max, err, err, k
+        be2d_fused(q, q_fixed, gather, vec_slot, mat_slot, False, rbuf, kdata,
+                   dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4)
+        err_new = alpha_finish(r, rbuf, m_data, indptr, indices, a, lam, f_ext)
+        if k >= max_k or not carry_on(err_new, err, threshold, contraction):
+            return dx_max, err_new, err, k
+        err = err_new
+
+
 class BE2DCompiled(Kernel):
     """The compiled kernel object of BE2D: :func:`be2d_forces` and the fused entry point :func:`be2d_fused`."""
 
@@ -186,3 +212,7 @@ class BE2DCompiled(Kernel):
     def fused(self, geom: dict) -> tuple:
         """``(be2d_fused, args)``: the fused assembly entry point (see :meth:`ancfdae.models.Element.fused_kernel`)."""
         return be2d_fused, self._args(geom)
+
+    def alpha_iterations(self, geom: dict) -> tuple:
+        """``(be2d_alpha_iterations, args)``: compiled Newton iterations (:mod:`ancfdae.models.beam.iteration_numba`)."""
+        return be2d_alpha_iterations, self._args(geom)
