@@ -70,10 +70,6 @@ class _AlphaFamily(NewtonStepper):
         self.beta, self.gamma, self.alpha_m, self.alpha_f = beta, gamma, alpha_m, alpha_f
         self._offer = (None, None)   # (model, its compiled_residual), taken at the first step of a run
 
-    def _setup(self) -> None:
-        super()._setup()
-        self._offer = (None, None)
-
     def options(self) -> dict:
         """The options as a JSON-able dict (stored in the Result).
 
@@ -86,9 +82,11 @@ class _AlphaFamily(NewtonStepper):
         o.update(beta=self.beta, gamma=self.gamma, alpha_m=self.alpha_m, alpha_f=self.alpha_f)
         return o
 
-    def _setup(self):
-        """The Newton set-up; on a constrained model the algorithmic acceleration starts at ``a0``."""
+    def _setup(self) -> None:
+        """The Newton set-up (the model's compiled offer taken afresh); on a constrained model the algorithmic
+        acceleration starts at ``a0``."""
         super()._setup()
+        self._offer = (None, None)
         self._constrained = "constraints" in capabilities(self.model)
         if self._constrained:
             self._ah = self.a.copy()
