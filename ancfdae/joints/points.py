@@ -99,7 +99,7 @@ class Distance(Joint):
 
 
 class Prismatic(Joint):
-    """A point stays on a line: ``(r_a - r_b) . n_k = 0`` for the normals ``n_k`` of the line (dim - 1 rows).
+    """A point stays on a line: ``(r_a - r_b) · n_k = 0`` for the normals ``n_k`` of the line (dim - 1 rows).
 
     Parameters
     ----------
