@@ -14,9 +14,12 @@ and the Python iteration; inlined into one function, LLVM may round the residual
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from .beam import Beam
 
 __all__ = ["CompiledResidual", "compiled_residual"]
 
@@ -47,7 +50,7 @@ class CompiledResidual:
     load_factor: float
 
 
-def compiled_residual(beam) -> CompiledResidual | None:
+def compiled_residual(beam: Beam) -> CompiledResidual | None:
     """The beam's compiled Newton iterations, or None when it has none (see the module docstring)."""
     if not beam.mass_is_constant or beam._load_set.moments or not beam.element.kernel_twins:
         return None
