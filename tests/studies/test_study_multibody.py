@@ -103,3 +103,12 @@ def test_quick_study_rows_and_orders(tmp_path):
     assert r["orders"][("B6", "generalized-alpha")] > 1.0
     assert all(row["drift_q"] < 1e-8 for row in rows)
     assert (tmp_path / "multibody.md").is_file()
+
+
+def test_quick_study_runs_the_variable_step_method_at_its_tolerances(tmp_path):
+    # Catches: a step h handed to IDA (simulate refuses it: every IDA case failed), rtols not applied.
+    r = multibody.run(benchmarks=["B5"], integrators=["ida"], quick=True, out=tmp_path, progress=False)
+    assert not r["errors"], r["errors"]
+    assert [row["h"] for row in r["rows"]] == list(multibody.QUICK["rtols"])
+    assert all(row["status"] == "success" for row in r["rows"])
+    assert r["rows"][-1]["error"] < r["rows"][0]["error"]
