@@ -130,7 +130,9 @@ class System(BodyStack):
         f = self._joint_set.force(t, q, lam[mb:])
         r = 0
         for b, o, m in self._body_rows:
-            f[o:o + b.n_dof] += b.constraint_jacobian(t, q[o:o + b.n_dof]).T @ lam[r:r + m]
+            qb, lb = q[o:o + b.n_dof], lam[r:r + m]
+            f[o:o + b.n_dof] += (b.constraint_force(t, qb, lb) if hasattr(b, "constraint_force")
+                                 else b.constraint_jacobian(t, qb).T @ lb)
             r += m
         return f
 

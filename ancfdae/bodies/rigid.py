@@ -234,6 +234,12 @@ class RigidBody:
         self._check(q)
         return self._ortho.constraint_jacobian(t, q)
 
+    def constraint_force(self, t: float, q: np.ndarray, lam: np.ndarray) -> np.ndarray:
+        """``G^T lambda`` without forming ``G`` (the optional fast path of the constraints capability)."""
+        self._check(q)
+        check_shape("lam", lam, (self.n_constraints,), f"n_constraints = {self.n_constraints}")
+        return self._ortho.constraint_force(t, q, lam)
+
     def constraint_force_jacobian(self, t: float, q: np.ndarray, lam: np.ndarray) -> sp.csr_matrix:
         """``d(G^T lambda)/dq`` (constant in q)."""
         check_shape("lam", lam, (self.n_constraints,), f"n_constraints = {self.n_constraints}")

@@ -97,6 +97,8 @@ def test_constraint_derivatives_against_finite_differences(dim):
     assert rel_err(G.toarray(), fd_gradient(lambda x: body.constraints(0.0, x), q)) < 1e-9
     H = body.constraint_force_jacobian(0.0, q, lam).toarray()
     assert rel_err(H, fd_gradient(lambda x: body.constraint_jacobian(0.0, x).T @ lam, q)) < 1e-9
+    # The fast path G^T lam without G (a cross row adding to one director only, or the wrong director).
+    assert rel_err(body.constraint_force(0.0, q, lam), G.T @ lam) < 1e-14
     # The pattern is fixed: the same indices at any state.
     G2 = body.constraint_jacobian(0.0, RNG.standard_normal(n))
     assert np.array_equal(G.indices, G2.indices) and np.array_equal(G.indptr, G2.indptr)
