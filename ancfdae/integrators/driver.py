@@ -41,9 +41,8 @@ from ancfdae.integrators._recorder import Recorder
 from ancfdae.integrators.protocol import Stepper
 from ancfdae.problem import Model, capabilities
 
-if TYPE_CHECKING:                       # for annotations only
-    from ancfdae.monitors import Monitor
-    from ancfdae.result import Result
+if TYPE_CHECKING:                       # for annotations only (monitors are named, not imported: they stand
+    from ancfdae.result import Result   # above the integrators, e.g. DirectorGeometry reads BE3D's directors)
 
 __all__ = ["check_model", "consistent_acceleration", "output_times", "integrate", "GRID_TOL",
            "DEFAULT_MAX_STEPS"]
@@ -189,8 +188,8 @@ class _Progress:
 
 
 def integrate(stepper: Stepper, model: Model, t_span: tuple[float, float], t_eval: ArrayLike | None = None,
-              monitors: Sequence[Monitor] = (), hooks: Sequence[Callable] = (), q0: ArrayLike | None = None,
-              v0: ArrayLike | None = None, state0: dict | None = None, max_steps: int | None = None,
+              monitors: Sequence["ancfdae.monitors.Monitor"] = (), hooks: Sequence[Callable] = (),
+              q0: ArrayLike | None = None, v0: ArrayLike | None = None, state0: dict | None = None, max_steps: int | None = None,
               progress: bool = False) -> Result:
     """Run ``stepper`` (a :class:`~.protocol.Stepper`) on ``model`` over ``t_span``.
 

@@ -14,12 +14,9 @@ and the Python iteration; inlined into one function, LLVM may round the residual
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Callable
+from typing import Callable
 
 import numpy as np
-
-if TYPE_CHECKING:
-    from .beam import Beam
 
 __all__ = ["CompiledResidual", "compiled_residual"]
 
@@ -50,7 +47,8 @@ class CompiledResidual:
     load_factor: float
 
 
-def compiled_residual(beam: Beam) -> CompiledResidual | None:
+# the beam is named, not imported: beam.py imports this module
+def compiled_residual(beam: "ancfdae.models.Beam") -> CompiledResidual | None:
     """The beam's compiled Newton iterations, or None when it has none (see the module docstring)."""
     if not beam.mass_is_constant or beam._load_set.moments or not beam.element.kernel_twins:
         return None
