@@ -38,13 +38,7 @@ class Spherical(Joint):
 
     def rows(self, frames: tuple[Frame, ...], q0: np.ndarray, n: int) -> Rows:
         dim = self.check_dim(frames)
-        fa, fb = frames
-        if self.at is not None and not (fa.ground or fb.ground):
-            raise ValueError(f"`at` is the ground point: {self.label(frames)} has no ground side.")
-        body = fb if fa.ground else fa
-        ground = vector("at", self.at, dim) if self.at is not None else body.point.value(q0)
-        pa = constant(ground, n) if fa.ground else fa.point
-        pb = constant(ground, n) if fb.ground else fb.point
+        pa, pb = _points(self, frames, q0, n, dim)
         rows = Rows(n)
         linear(rows, self.label(frames), pa - pb)
         return rows
@@ -77,13 +71,7 @@ class Distance(Joint):
 
     def rows(self, frames: tuple[Frame, ...], q0: np.ndarray, n: int) -> Rows:
         dim = self.check_dim(frames)
-        fa, fb = frames
-        if self.at is not None and not (fa.ground or fb.ground):
-            raise ValueError(f"`at` is the ground point: {self.label(frames)} has no ground side.")
-        body = fb if fa.ground else fa
-        ground = vector("at", self.at, dim) if self.at is not None else body.point.value(q0)
-        pa = constant(ground, n) if fa.ground else fa.point
-        pb = constant(ground, n) if fb.ground else fb.point
+        pa, pb = _points(self, frames, q0, n, dim)
         d = pa - pb
         L = self.length if self.length is not None else float(np.linalg.norm(d.value(q0)))
         if L <= 0:
@@ -156,3 +144,14 @@ class Prismatic(Joint):
         for k, i in enumerate(self.normals):
             dot(rows, f"{label}[{k}]", d, axis(fl, "normals", i))
         return rows
+
+
+def _points(joint: Joint, frames: tuple[Frame, ...], q0: np.ndarray, n: int, dim: int) -> tuple:
+    """The two sides' points as affine maps of q; a ground side is the fixed point ``joint.at`` (default: the
+    body's point in ``q0``, so the joint holds the initial configuration)."""
+    fa, fb = frames
+    if joint.at is not None and not (fa.ground or fb.ground):
+        raise ValueError(f"`at` is the ground point: {joint.label(frames)} has no ground side.")
+    body = fb if fa.ground else fa
+    ground = vector("at", joint.at, dim) if joint.at is not None else body.point.value(q0)
+    return (constant(ground, n) if fa.ground else fa.point), (constant(ground, n) if fb.ground else fb.point)
