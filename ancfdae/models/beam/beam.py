@@ -123,7 +123,7 @@ class Beam(MassForms):
             raise ValueError("`supports` fix every coordinate; nothing is left to solve for.")
         free_of_full = np.full(self.q_ref.size, -1)
         free_of_full[self.free] = np.arange(self.n_dof)
-        self._asm = Assembler(self.edofs, free_of_full, self.n_dof)
+        self._asm = Assembler(self.edofs, free_of_full, self.n_dof, element.n_node_dof)
         self.mass_is_constant = bool(element.mass_is_constant)
         self._M_data = self._asm.data(element.mass_matrix(self.geom))
         self._M_csr = self._asm.csr(self._M_data)   # constant-mass product M a, built once
