@@ -9,6 +9,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from .pattern_numba import diagonal_slots, element_slots, row_columns
+
 __all__ = ["Assembler", "entry_pattern", "node_pattern", "element_nodes_of"]
 
 
@@ -86,7 +88,8 @@ def node_pattern(nodes: np.ndarray, free_of_full: np.ndarray, node_dof: int
     coordinates of each pair. Every row of a node has the same columns (those of the node's neighbours,
     ascending since free indices ascend with full indices); an entry's slot is its row's start, plus the
     offset of its column node among the row node's neighbours, plus its column's rank among the free
-    coordinates of that node. All in whole-array operations.
+    coordinates of that node. The pairs in whole-array operations, the n_el * n_edof**2 slots and the
+    columns in compiled loops (:mod:`.pattern_numba`).
     """
     n_el, npe = nodes.shape
     F = free_of_full.reshape(-1, node_dof)                     # free index per (node, coordinate) or -1
@@ -106,20 +109,14 @@ def node_pattern(nodes: np.ndarray, free_of_full: np.ndarray, node_dof: int
     node_cols = F[b][free_mask[b]]                              # every node's columns, pair by pair
     free_full = np.flatnonzero(free_of_full >= 0)               # free_of_full[free_full] = 0, 1, 2, ...
     row_node = free_full // node_dof
-    row_len = node_len[row_node]
-    indptr = np.concatenate([[0], np.cumsum(row_len)])
+    indptr = np.concatenate([[0], np.cumsum(node_len[row_node])])
     nnz = int(indptr[-1])
-    take = np.repeat(node_ptr[row_node] - indptr[:-1], row_len) + np.arange(nnz)
-    indices = node_cols[take].astype(np.int32)
-    Fe = F[nodes]                                               # (n_el, npe, node_dof)
-    # A fixed row starts at nnz and a fixed column ranks nnz, so that the minimum with nnz sends every
-    # entry with a fixed row or column to the extra bin (offsets are >= 0).
-    row_start = np.where(Fe >= 0, indptr[np.maximum(Fe, 0)], nnz)
-    col_rank = np.where(Fe >= 0, rank[nodes], nnz)
-    slot = offset[pair_of].reshape(n_el, npe, 1, npe, 1) + col_rank[:, None, None, :, :]
-    slot = slot + row_start[:, :, :, None, None]
-    slot_all = np.minimum(slot, nnz, out=slot).astype(np.intp, copy=False).ravel()
-    return indptr.astype(np.int32), indices, slot_all
+    indices = np.empty(nnz, dtype=np.int32)
+    row_columns(row_node, node_ptr, node_cols.astype(np.int32), indptr, indices)
+    slot_all = np.empty((n_el, npe, node_dof, npe, node_dof), dtype=np.intp)
+    element_slots(nodes.astype(np.intp), F.astype(np.intp), rank.astype(np.intp), indptr.astype(np.intp),
+                  offset.astype(np.intp), pair_of.astype(np.intp).ravel(), nnz, slot_all)
+    return indptr.astype(np.int32), indices, slot_all.ravel()
 
 
 class Assembler:
@@ -192,9 +189,9 @@ class Assembler:
 
 def _diagonal_slots(indptr: np.ndarray, indices: np.ndarray) -> np.ndarray:
     """Data position of the diagonal entry of every row (each row of an element pattern holds it)."""
-    n = indptr.size - 1
-    row_of = np.repeat(np.arange(n, dtype=np.int32), np.diff(indptr))
-    hit = np.flatnonzero(indices == row_of)
-    if hit.size != n:
-        raise ValueError(f"the assembly pattern lacks {n - hit.size} diagonal entries (a coordinate in no element)")
+    hit = np.empty(indptr.size - 1, dtype=np.intp)
+    diagonal_slots(indptr, indices, hit)
+    if np.any(hit < 0):
+        raise ValueError(f"the assembly pattern lacks {int(np.sum(hit < 0))} diagonal entries (a coordinate in "
+                         "no element)")
     return hit

@@ -81,9 +81,7 @@ class LoadSet:
         self.moments = []
         self.gravity = np.zeros(self.n_dof)
         self._gravity_columns = {}
-        sq, wq = gauss(6)
-        S_all = el.shape_matrix(sq, lengths)                       # (n_el, n_pts, dim, nd)
-        w_el = wq[None, :] * lengths[:, None] / 2
+        S_all = w_el = None        # the distributed loads' shape matrices, built for the first of them
         for load in loads:
             if isinstance(load, (PointForce, PointMoment)):
                 s = s_nodes[node_index(load.node, s_nodes.size, "load")] if load.node is not None else load.s
@@ -105,6 +103,10 @@ class LoadSet:
                 w = load.g if isinstance(load, Gravity) else load.w
                 if w.shape[0] != dim:
                     raise ValueError(f"gravity/line load must have {dim} components for {el.name}, got {w.shape[0]}.")
+                if S_all is None:
+                    sq, wq = gauss(6)
+                    S_all = el.shape_matrix(sq, lengths)           # (n_el, n_pts, dim, nd)
+                    w_el = wq[None, :] * lengths[:, None] / 2
                 rhoA = el.material.rho * el.section.A if isinstance(load, Gravity) else 1.0
                 fe = rhoA * np.einsum("ep,epdk,d->ek", w_el, S_all, w)
                 if isinstance(load, Gravity):

@@ -19,7 +19,7 @@ from ...materials import CircularSection, Material, RectangularSection
 from ..element import Element, Kernel
 from .continuum import voigt
 from .kernels import SQReference
-from .points import local_map, rule, shapes
+from .points import local_variables, rule, shapes
 from .structural import structural_kernel
 
 __all__ = ["SQElement", "shear_factors"]
@@ -166,9 +166,8 @@ class SQElement(Element):
             which = [k for k, t in enumerate(self._terms) if self.quadrature[t] == r]
             s, w = rule(*r)
             N, dN = shapes(self.nodes, s, lengths)
-            B = local_map(N, dN, self.dim)
-            E, P = B.shape[:2]
-            v = np.einsum("epvi,ei->epv", B, q_ref).reshape(E * P, -1)
+            E, P = N.shape[:2]
+            v = local_variables(N, dN, q_ref, self.dim).reshape(E * P, -1)
             npv = self.dim * (self.dim - 1)
             jac = np.linalg.norm(v[:, npv:npv + self.dim], axis=1)      # |r_ref'| = dS/dxi (Eq. 15)
             zeros = np.zeros((E * P, len(which)))
@@ -178,7 +177,7 @@ class SQElement(Element):
             scale = np.where(cs[None, :], jac[:, None], 1.0 / jac[:, None])
             wq = (w[None, :] * lengths[:, None] / 2).reshape(-1)
             Dw = self._stiffness()[which][None, :] * wq[:, None] * scale
-            groups.append({"which": which, "B": B, "ref": raw, "Dw": Dw, "N": N, "dN": dN})
+            groups.append({"which": which, "ref": raw, "Dw": Dw, "N": N, "dN": dN})
         geom["groups"] = groups
 
     def _section_points(self):
@@ -225,8 +224,7 @@ class SQElement(Element):
     def _prepare_continuum(self, geom, q_ref, lengths):
         s, w = rule(*self.quadrature["axial"])
         N, dN = shapes(self.nodes, s, lengths)
-        B = local_map(N, dN, self.dim)
-        E, P = B.shape[:2]
+        E, P = N.shape[:2]
         pts, ws = self._section_points()
         D, D0, Dnu = self._elasticity()
         if self.formulation == "continuum":
@@ -242,7 +240,7 @@ class SQElement(Element):
         for k in range(1, self.dim):
             Pc[:, 0, self.dim - 1 + k] = pts[:, k - 1]
             Pc[:, k, k - 1] = 1.0                                       # x_eta = a2, x_zeta = a3
-        v = np.einsum("epvi,ei->epv", B, q_ref).reshape(E * P, -1)
+        v = local_variables(N, dN, q_ref, self.dim).reshape(E * P, -1)
         X = np.einsum("scb,pbi->psic", Pc, v.reshape(E * P, nb, self.dim))
         C = np.einsum("psic,psid->pscd", X, X)
         if np.abs(C - np.eye(self.dim)).max() > 1e-10:
@@ -252,7 +250,7 @@ class SQElement(Element):
         _, T = voigt(self.dim)
         ref = 0.5 * np.einsum("acd,pscd->psa", T, C)
         wax = (w[None, :] * lengths[:, None] / 2).reshape(-1)
-        geom["groups"] = [{"B": B, "Pc": Pc, "ws": ws, "Ds": Ds, "ref": ref, "wax": wax, "N": N, "dN": dN}]
+        geom["groups"] = [{"Pc": Pc, "ws": ws, "Ds": Ds, "ref": ref, "wax": wax, "N": N, "dN": dN}]
 
     def _mass(self, lengths, q_ref):
         """``rho int S^T S dV`` (Eq. 27): ``rho int N_i N_j dS`` times diag(A, I3, I2) per node vector."""
@@ -264,8 +262,14 @@ class SQElement(Element):
         m = np.einsum("ep,epi,epj->eij", w[None, :] * lengths[:, None] / 2 * jac, N, N)
         sec = self.section
         c = self.material.rho * np.array([sec.A, sec.I3, sec.I2])[:self._nvec]
-        M = np.einsum("eij,a,ab,cd->eiacjbd", m, c, np.eye(self._nvec), np.eye(self.dim))
-        n = nn * self._nvec * self.dim
+        # M[e, (i, a, c), (j, b, d)] = m[e, i, j] c[a] delta_ab delta_cd, written block by block.
+        nv, d = self._nvec, self.dim
+        M = np.zeros((len(lengths), nn, nv, d, nn, nv, d))
+        for a in range(nv):
+            mc = m * c[a]
+            for k in range(d):
+                M[:, :, a, k, :, a, k] = mc
+        n = nn * nv * d
         return M.reshape(len(lengths), n, n)
 
     # -- kernels ----------------------------------------------------------------------------

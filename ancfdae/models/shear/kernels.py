@@ -14,7 +14,7 @@ import numpy as np
 from ..element import OnePassKernel
 from .continuum import continuum_kernel
 from .moment import moment_load
-from .points import assemble
+from .points import assemble, local_map
 from .structural import structural_kernel
 
 __all__ = ["SQReference"]
@@ -34,7 +34,7 @@ class SQReference(OnePassKernel):
         q = np.asarray(q, dtype=float)
         W, f, K = 0.0, 0.0, None
         for grp in geom["groups"]:
-            B = grp["B"]
+            B = local_map(grp["N"], grp["dN"], el.dim)    # (n_el, n_pts, n_v, n_edof): not kept in geom
             E, P, nv = B.shape[:3]
             v = np.einsum("epvi,ei->epv", B, q).reshape(E * P, nv)
             if el.formulation == "structural":
