@@ -248,12 +248,17 @@ class BE2D(Element):
                 "dN": np.ascontiguousarray(dN.transpose(2, 0, 1))[:, None],  # (4, 1, n_el, n_pts)
                 "ddN": np.ascontiguousarray(ddN.transpose(2, 0, 1))[:, None],
                 "n_a": sa.size}
-        # Constant Hessians of g = r'.r' and c = (r' x r'').e_z, stacked as (n_el, 2*n_pts, 64).
-        I2 = np.eye(2)
-        d2g = 2.0 * np.einsum("epk,epl,ab->epkalb", dN, dN, I2)
-        d2c = np.einsum("epk,epl,ab->epkalb", dN, ddN, _P) + np.einsum("epk,epl,ab->epkalb", ddN, dN, _P.T)
-        geom["d2"] = np.stack([d2g.reshape(n_el, n_pts, 64), d2c.reshape(n_el, n_pts, 64)], axis=1
-                              ).reshape(n_el, 2 * n_pts, 64)
+        # Constant Hessians of g = r'.r' and c = (r' x r'').e_z, stacked as (n_el, 2*n_pts, 64):
+        # d2g[k, a, l, b] = 2 N'_k N'_l delta_ab, d2c[k, a, l, b] = N'_k N''_l P_ab + N''_k N'_l P_ba
+        # (P_01 = 1, P_10 = -1), written block by block into one array (no temporaries of its size).
+        d2 = np.zeros((n_el, 2, n_pts, 4, 2, 4, 2))
+        gg = 2.0 * (dN[:, :, :, None] * dN[:, :, None, :])
+        x, y = dN[:, :, :, None] * ddN[:, :, None, :], ddN[:, :, :, None] * dN[:, :, None, :]
+        for a in range(2):
+            d2[:, 0, :, :, a, :, a] = gg
+        d2[:, 1, :, :, 0, :, 1] = x - y
+        d2[:, 1, :, :, 1, :, 0] = y - x
+        geom["d2"] = d2.reshape(n_el, 2 * n_pts, 64)
         g, c = invariants(geom, q_ref, order=0)
         geom["eps_ref"] = np.sqrt(g) - 1.0
         geom["K_ref"] = c / g
@@ -266,7 +271,10 @@ class BE2D(Element):
         N, _, _ = hermite(sm, lengths)
         m = np.einsum("ep,epi,epj->eij", wm[None, :] * lengths[:, None] / 2, N, N)
         rhoA = self.material.rho * self.section.A
-        geom["M"] = rhoA * np.einsum("eij,kl->eikjl", m, I2).reshape(-1, 8, 8)
+        M = np.zeros((n_el, 4, 2, 4, 2))                            # rhoA m_ij delta_kl
+        for k in range(2):
+            M[:, :, k, :, k] = rhoA * m
+        geom["M"] = M.reshape(-1, 8, 8)
         return geom
 
     # -- kernels --------------------------------------------------------
