@@ -53,6 +53,12 @@ def max_abs(x):
     return m
 
 
+def _keeps(rate, err, target, k_max):
+    """True when a stale matrix contracting at ``rate < 1`` reaches ``target`` from ``err`` within ``k_max``
+    further iterations (``NewtonOptions.stale_iterations``), so that a refresh would cost more than it saves."""
+    return k_max > 0 and rate < 1.0 and err * rate ** k_max <= target
+
+
 class _Factor:
     """LU factorisation (banded LAPACK, dense LAPACK or SuperLU; see ``_linsolve``)."""
 
@@ -321,7 +327,7 @@ class NewtonSolver:
                                              f"iteration {k} with a fresh Jacobian)", floor), stale
                 else:
                     diverging = 0
-                if not full:
+                if not full and not _keeps(rate, err, threshold, opts.stale_iterations):
                     self._lu = None  # refresh at the current iterate
             else:
                 diverging = 0
