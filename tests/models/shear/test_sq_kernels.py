@@ -96,3 +96,16 @@ def test_numba_moment_load_equals_numpy(steel, cls, nodes):
                 out.append((f, K))
             (f0, K0), (f1, K1) = out
             assert rel_err(f1, f0) < 1e-12 and rel_err(K1, K0) < 1e-12
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_local_variables_in_chunks_equal_the_whole_mesh_product(dim):
+    # The reference geometry's local variables are formed a chunk of elements at a time (no B for the
+    # whole mesh); catches a chunk boundary that drops or repeats elements, or a different sum order.
+    from ancfdae.models.shear.points import local_map, local_variables, rule, shapes
+    lengths = np.random.default_rng(1).uniform(0.5, 1.5, 7)
+    N, dN = shapes(3, rule("gauss", 3)[0], lengths)
+    q = np.random.default_rng(2).standard_normal((7, 3 * dim * dim))
+    whole = np.einsum("epvi,ei->epv", local_map(N, dN, dim), q)
+    for chunk in (1, 3, 7, 100):
+        assert np.array_equal(local_variables(N, dN, q, dim, chunk=chunk), whole)
