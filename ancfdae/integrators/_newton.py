@@ -53,12 +53,6 @@ def max_abs(x):
     return m
 
 
-def _keeps(rate, err, target, k_max):
-    """True when a stale matrix contracting at ``rate < 1`` reaches ``target`` from ``err`` within ``k_max``
-    further iterations (``NewtonOptions.stale_iterations``), so that a refresh would cost more than it saves."""
-    return k_max > 0 and rate < 1.0 and err * rate ** k_max <= target
-
-
 class _Factor:
     """LU factorisation (banded LAPACK, dense LAPACK or SuperLU; see ``_linsolve``)."""
 
@@ -327,7 +321,7 @@ class NewtonSolver:
                                              f"iteration {k} with a fresh Jacobian)", floor), stale
                 else:
                     diverging = 0
-                if not full and not _keeps(rate, err, threshold, opts.stale_iterations):
+                if not full:
                     self._lu = None  # refresh at the current iterate
             else:
                 diverging = 0

@@ -66,12 +66,6 @@ class NewtonOptions:
     retry : bool
         Modified Newton only: retry a failed solve once from the initial guess
         with a fresh matrix when the failed attempt had used a stale one.
-    stale_iterations : int
-        Modified Newton only: a matrix whose rate exceeds ``contraction`` is kept (no refresh) while
-        the rate is below 1 and would reach the tolerance within this many further iterations
-        (``rate**k * max|r_k| <= target``); 0 (the default) refreshes at once, the chapter's policy.
-        For fine SQ3D meshes, whose iterations end with a slow rate of 0.5-0.7 a step or two from
-        the target (``benchmarks/sq3d_scaling.py``). ``>= 0``.
     xtol : float
         Also converged when the residual stagnates at round-off level: a
         matrix evaluated in the current attempt, a residual that fell by less
@@ -88,7 +82,6 @@ class NewtonOptions:
     contraction: float = 0.3
     retry: bool = True
     xtol: float = 1e-11
-    stale_iterations: int = 0
 
     def __post_init__(self):
         _real("tol", self.tol, low=0.0, high=1.0, low_open=True, high_open=True)
@@ -100,9 +93,6 @@ class NewtonOptions:
             raise ValueError(f"`jacobian` must be one of ['full', 'modified'], got {self.jacobian!r}.")
         _real("contraction", self.contraction, low=0.0, high=1.0, low_open=True, high_open=True)
         _real("xtol", self.xtol, low=0.0)
-        if (isinstance(self.stale_iterations, bool) or not isinstance(self.stale_iterations, numbers.Integral)
-                or self.stale_iterations < 0):
-            raise ValueError(f"`stale_iterations` must be an integer >= 0, got {self.stale_iterations!r}.")
         if not isinstance(self.retry, bool):
             raise ValueError(f"`retry` must be True or False, got {self.retry!r}.")
 
