@@ -36,7 +36,7 @@ def main(argv=None):
     ap.add_argument("--elements", type=int, nargs="+", default=[64, 256, 1024, 4096])
     ap.add_argument("--h", type=float, default=1e-4)
     ap.add_argument("--steps", type=int, default=50)
-    ap.add_argument("--predictor", default="constant", choices=["constant", "extrapolate", "linearized"])
+    ap.add_argument("--predictor", default="constant", choices=["constant", "extrapolate"])
     ap.add_argument("--contraction", type=float, default=0.3, help="modified Newton's refresh rate")
     a = ap.parse_args(argv)
     print(f"CPU = process time; Lobatto IIIA-3, h = {a.h:g}, {a.steps} steps, predictor {a.predictor}, "

@@ -101,17 +101,6 @@ class NewtonSolver:
         """Drop the cached factorisation; the next iteration refactorises."""
         self._lu = None
 
-    def prime(self, matrix) -> bool:
-        """Factorise ``matrix`` and keep it as the cached factorisation (a caller that evaluated the
-        Newton matrix itself, e.g. for a predictor); counted as a Jacobian evaluation and a
-        factorisation. Returns False (nothing cached) when the factorisation fails."""
-        msg, _ = self._refresh(None, None, matrix, 0.0, True)
-        return msg is None
-
-    def solve_cached(self, rhs: np.ndarray) -> np.ndarray:
-        """``J^-1 rhs`` with the cached factorisation (call only while :attr:`has_factorization`)."""
-        return self._lu.solve(rhs)
-
     @property
     def has_factorization(self) -> bool:
         """True while a factorisation is cached."""

@@ -39,7 +39,6 @@ import scipy.sparse as sp
 from ancfdae import _validate as validate
 from ancfdae.integrators._affine import affine2, stage_constants, stage_states
 from ancfdae.integrators._linsolve import StageMatrix
-from ancfdae.integrators._stage_predictor import linearized_guess
 from ancfdae.constrained import multipliers
 from ancfdae.integrators._newton_records import NewtonOptions
 from ancfdae.integrators.lobatto_constrained import GGLStages, ggl_step
@@ -150,17 +149,13 @@ class LobattoIIIA(NewtonStepper):
         accurate.
     newton : NewtonOptions or dict, optional
         Default: modified Newton, relative tolerance 1e-8 (chapter Sect. 5.2).
-    predictor : {"constant", "extrapolate", "linearized"}
+    predictor : {"constant", "extrapolate"}
         Initial guess of the stage accelerations: ``a_n`` in every stage
-        (default), the previous step's collocation polynomial
-        extrapolated, or the stage equations linearized at the step's start
-        solved once (:mod:`ancfdae.integrators._stage_predictor`). With the
-        relative residual test the iteration count depends on the
-        contraction rate, not on the initial residual: on the 25-element
-        BE2D pendulum (h = 1e-4) "extrapolate" took 5.0 instead of 4.7
-        iterations per step. "linearized" is for steps that leave stiff modes
-        unresolved (free-flying SQ3D, 16 el: runs at h = 1e-3, where the constant
-        guess fails); a failed solve from another predictor retries from it.
+        (default), or the previous step's collocation polynomial
+        extrapolated. With the relative residual test the iteration count
+        depends on the contraction rate, not on the initial residual: on
+        the 25-element BE2D pendulum (h = 1e-4) "extrapolate" took 5.0
+        instead of 4.7 iterations per step.
 
     Notes
     -----
@@ -186,7 +181,7 @@ class LobattoIIIA(NewtonStepper):
             raise ValueError(f"`stages`: tableau {tab.name!r} must have an explicit first stage and be stiffly "
                              "accurate (Lobatto IIIA type).")
         self.tableau = tab
-        self.predictor = validate.choice("predictor", predictor, ("extrapolate", "constant", "linearized"))
+        self.predictor = validate.choice("predictor", predictor, ("extrapolate", "constant"))
         self.name = f"lobatto{tab.stages}"
         self.order = tab.order
         s = tab.stages
@@ -212,7 +207,6 @@ class LobattoIIIA(NewtonStepper):
     def _setup(self):
         super()._setup()
         self._prev = None  # (h, stage accelerations (n, s)) of the last step
-        self._stage_blocks = None  # the blocks of the cached eigenbasis stage matrix (linearized predictor)
         self._w_cache = None
         self._stages = "residual_stages" in capabilities(self.model)   # declared, forwarded by the proxy
         self._ggl = None
@@ -331,27 +325,17 @@ class LobattoIIIA(NewtonStepper):
                     blk = model.jacobian(ts[-1], Q[:, -1], V_[:, -1], X[:, -1])
                     floor = self.floor_of(blk.K, Q[:, -1])
                     if blk.same_pattern:
-                        self._stage_blocks = blk
                         return StageMatrix(blk, h, self._a_rest), floor
-                    self._stage_blocks = None
                     blocks = [blk if i == m - 1 else model.jacobian(ts[i], Q[:, i], V_[:, i], X[:, i])
                               for i in range(m)]
                     return self._matrix(blocks, h), floor
-                self._stage_blocks = None
                 blocks = [model.jacobian(ts[i], Q[:, i], V_[:, i], X[:, i]) for i in range(m)]
                 # the residual holds every stage: the floor of the largest
                 floor = max(self.floor_of(blk.K, Q[:, i]) for i, blk in enumerate(blocks))
                 return self._matrix(blocks, h), floor
 
         guess = self._guess(h).ravel()
-        linear = m > 1 and eigen[0]       # the linearized predictor needs the eigenbasis stage matrix
-        if linear and self.predictor == "linearized":
-            guess = linearized_guess(self, t, h, ts, Q0, V0, CQ, CV, guess)
         out = self._solve(residual, jacobian, guess)
-        if not out.converged and linear and self.predictor != "linearized":
-            # An unresolved stiff mode can put the guess out of Newton's reach (:mod:`._stage_predictor`).
-            self.newton.invalidate()
-            out = self._solve(residual, jacobian, linearized_guess(self, t, h, ts, Q0, V0, CQ, CV, guess))
         if not out.converged and m > 1 and eigen[0]:
             # The one-state eigenbasis matrix can be too crude where the stages differ much (large
             # steps, strong nonlinearity): before failing, retry the step with the exact per-stage matrix.
