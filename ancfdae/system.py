@@ -164,6 +164,14 @@ class System(BodyStack):
             return self._joint_set.g_and_force(t, q, lam)
         return self.constraints(t, q), self.constraint_force(t, q, lam)
 
+    def constraint_position_terms(self, t: float, q: np.ndarray) -> tuple[np.ndarray, sp.csr_matrix, np.ndarray]:
+        """``(g, G, g_t)`` at ``(t, q)``: one compiled pass when every row is folded (a GGL stage needs all
+        three), else :meth:`constraints`, :meth:`constraint_jacobian` and :meth:`constraint_rates`."""
+        if not self._body_rows and hasattr(self._joint_set, "position_terms"):
+            return self._joint_set.position_terms(t, q)
+        return (self.constraints(t, q), self.constraint_jacobian(t, q),
+                self.constraint_rates(t, q, np.zeros_like(q))[0])
+
     def constraint_jacobian(self, t: float, q: np.ndarray) -> sp.csr_matrix:
         """``G = dg/dq`` on a fixed pattern, shape (n_constraints, n_dof)."""
         blocks = [(b.constraint_jacobian(t, q[o:o + b.n_dof]), o) for b, o, _ in self._body_rows]

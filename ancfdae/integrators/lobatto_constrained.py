@@ -114,6 +114,8 @@ class GGLStages:
         self.inv_perm = np.empty_like(self.perm)
         self.inv_perm[self.perm] = np.arange(self.perm.size)
         self.stages = model.residual_stages if "residual_stages" in capabilities(model) else None
+        # (g, G, g_t) of a stage in one pass when the model offers it (a compiled System)
+        self.position_terms = getattr(model, "constraint_position_terms", None)
 
     def _ordering(self, G):
         """Permutation of ``[A (n ns), Lam (m ns), U (m ns)]`` (stage copies interleaved): each
@@ -188,9 +190,12 @@ class GGLStages:
             q, v = Q[:, i], V[:, i]
             if self.stages is None:
                 RD[:, i] = model.residual(ts[i], q, v, A[:, i])
-            G = as_csr(model.constraint_jacobian(ts[i], q))
-            g = np.asarray(model.constraints(ts[i], q), dtype=float)
-            g_t = np.asarray(model.constraint_rates(ts[i], q, v)[0], dtype=float)
+            if self.position_terms is not None:
+                g, G, g_t = self.position_terms(ts[i], q)
+            else:
+                G = as_csr(model.constraint_jacobian(ts[i], q))
+                g = np.asarray(model.constraints(ts[i], q), dtype=float)
+                g_t = np.asarray(model.constraint_rates(ts[i], q, v)[0], dtype=float)
             ggl_stage_rows(out, i, n, self.m, ns, ms, h, G.indptr, G.indices, G.data.astype(float, copy=False),
                            K, V, U, L, g, g_t)
         return out

@@ -5,7 +5,7 @@ compiled set (:mod:`ancfdae.joints.assembled_numba`); ``kernel="numpy"`` evaluat
 by body and the joints' in NumPy. On the B5, B6 and B7 models at random states (off the constraints, so
 every quadratic term counts) and at times inside the drives' ramps (``phi'`` and ``phi''`` non-zero) the two
 must agree in ``g``, ``G``, ``G^T lam``, ``d(G^T lam)/dq``, ``(g_t, gamma)``, ``Z(v) + G_t``, the one-pass
-``(g, G^T lam)`` and the KKT matrix. Caught: a quadratic entry dropped or halved in one kernel, a body's
+``(g, G^T lam)``, the one-pass ``(g, G, g_t)`` of a GGL stage and the KKT matrix. Caught: a quadratic entry dropped or halved in one kernel, a body's
 row folded with the wrong offset, sign or constant, a time derivative taken from the wrong weight row,
 ``G_t v`` without its factor 2, rows reordered (labels and values). Not caught here: a defect the two paths
 share (a joint's wrong row): ``test_joint_derivatives.py`` checks the rows against finite differences.
@@ -62,6 +62,9 @@ def test_compiled_rows_equal_reference(case):
         g1, f1 = fast.constraint_terms(t, q, lam)
         _close(ref.constraints(t, q), g1)
         _close(ref.constraint_force(t, q, lam), f1)
+        for x, y in zip(ref.constraint_position_terms(t, q), fast.constraint_position_terms(t, q)):
+            _close(x, y)
+        _close(fast.constraint_position_terms(t, q)[2], ref.constraint_rates(t, q, v)[0])
         M = ref.mass(q)
         _close(kkt_matrix(M, G, H), kkt_matrix(fast.mass(q), fast.constraint_jacobian(t, q),
                                                 fast.constraint_force_jacobian(t, q, lam)))
@@ -96,6 +99,10 @@ def test_compiled_set_equals_numpy_set_with_shared_timed_rows():
     for x, y in zip(ref.rates(t, q, v), fast.rates(t, q, v)):
         _close(x, y)
     _close(ref.velocity_jacobian(t, q, v), fast.velocity_jacobian(t, q, v))
+    g, G, g_t = fast.position_terms(t, q)
+    _close(ref.g(t, q), g)
+    _close(ref.G(t, q), G)
+    _close(ref.rates(t, q, v)[0], g_t)
 
 
 def test_kernel_argument_checked():
