@@ -157,20 +157,21 @@ class System(BodyStack):
             shifted.append(sp.csr_matrix((B.data, B.indices + o, B.indptr), shape=(B.shape[0], n)))
         return sp.vstack(shifted + [joint_part], format="csr")
 
-    def constraint_terms(self, t: float, q: np.ndarray, lam: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``(g(t, q), G(t, q)^T lam)``: one compiled pass when every row is folded (an index-3 residual needs
-        both at one state), else :meth:`constraints` and :meth:`constraint_force`."""
-        if not self._body_rows and hasattr(self._joint_set, "g_and_force"):
-            return self._joint_set.g_and_force(t, q, lam)
-        return self.constraints(t, q), self.constraint_force(t, q, lam)
+    def constraint_terms_at(self, t: float):
+        """``(q, lam) -> (g(t, q), G(t, q)^T lam)`` at the time ``t`` (an index-3 step's residuals): one compiled
+        pass, the time functions evaluated once, when every row is folded; else :meth:`constraints` and
+        :meth:`constraint_force`."""
+        if not self._body_rows and hasattr(self._joint_set, "terms_at"):
+            return self._joint_set.terms_at(t)
+        return lambda q, lam: (self.constraints(t, q), self.constraint_force(t, q, lam))
 
-    def constraint_position_terms(self, t: float, q: np.ndarray) -> tuple[np.ndarray, sp.csr_matrix, np.ndarray]:
-        """``(g, G, g_t)`` at ``(t, q)``: one compiled pass when every row is folded (a GGL stage needs all
-        three), else :meth:`constraints`, :meth:`constraint_jacobian` and :meth:`constraint_rates`."""
-        if not self._body_rows and hasattr(self._joint_set, "position_terms"):
-            return self._joint_set.position_terms(t, q)
-        return (self.constraints(t, q), self.constraint_jacobian(t, q),
-                self.constraint_rates(t, q, np.zeros_like(q))[0])
+    def constraint_position_terms_at(self, t: float):
+        """``q -> (g, G, g_t)`` at the time ``t`` (a GGL stage's rows): one compiled pass when every row is
+        folded, else :meth:`constraints`, :meth:`constraint_jacobian` and :meth:`constraint_rates`."""
+        if not self._body_rows and hasattr(self._joint_set, "position_terms_at"):
+            return self._joint_set.position_terms_at(t)
+        return lambda q: (self.constraints(t, q), self.constraint_jacobian(t, q),
+                          self.constraint_rates(t, q, np.zeros_like(q))[0])
 
     def constraint_jacobian(self, t: float, q: np.ndarray) -> sp.csr_matrix:
         """``G = dg/dq`` on a fixed pattern, shape (n_constraints, n_dof)."""

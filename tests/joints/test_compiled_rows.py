@@ -9,6 +9,7 @@ must agree in ``g``, ``G``, ``G^T lam``, ``d(G^T lam)/dq``, ``(g_t, gamma)``, ``
 row folded with the wrong offset, sign or constant, a time derivative taken from the wrong weight row,
 ``G_t v`` without its factor 2, rows reordered (labels and values). Not caught here: a defect the two paths
 share (a joint's wrong row): ``test_joint_derivatives.py`` checks the rows against finite differences.
+The multipliers at output times (dense KKT solve for small systems) against the sparse solve.
 """
 import numpy as np
 import pytest
@@ -59,12 +60,12 @@ def test_compiled_rows_equal_reference(case):
         for x, y in zip(ref.constraint_rates(t, q, v), fast.constraint_rates(t, q, v)):
             _close(x, y)
         _close(ref.constraint_velocity_jacobian(t, q, v), fast.constraint_velocity_jacobian(t, q, v))
-        g1, f1 = fast.constraint_terms(t, q, lam)
+        g1, f1 = fast.constraint_terms_at(t)(q, lam)
         _close(ref.constraints(t, q), g1)
         _close(ref.constraint_force(t, q, lam), f1)
-        for x, y in zip(ref.constraint_position_terms(t, q), fast.constraint_position_terms(t, q)):
+        for x, y in zip(ref.constraint_position_terms_at(t)(q), fast.constraint_position_terms_at(t)(q)):
             _close(x, y)
-        _close(fast.constraint_position_terms(t, q)[2], ref.constraint_rates(t, q, v)[0])
+        _close(fast.constraint_position_terms_at(t)(q)[2], ref.constraint_rates(t, q, v)[0])
         M = ref.mass(q)
         _close(kkt_matrix(M, G, H), kkt_matrix(fast.mass(q), fast.constraint_jacobian(t, q),
                                                 fast.constraint_force_jacobian(t, q, lam)))
@@ -121,3 +122,33 @@ def test_constant_mass_is_formed_once_and_read_only():
     assert np.array_equal(M.toarray(), blocks)
     with pytest.raises(ValueError):
         M.data[0] = 1.0
+
+
+def test_dense_multipliers_equal_sparse(monkeypatch):
+    """The multipliers at an output time by the dense KKT solve (small systems) equal SuperLU's on the sparse
+    matrix, and the pair satisfies M a + r + G^T lam = 0, G a = gamma (a block placed transposed, G^T
+    missing in the upper right, or the rows of gamma and -r swapped would fail)."""
+    import ancfdae.constrained as con
+    _, fast = _pair("b6")
+    rng = np.random.default_rng(5)
+    q0, _ = fast.initial_state()
+    q, v, t = q0 + 0.02 * rng.standard_normal(q0.size), rng.standard_normal(q0.size), TIMES["b6"]
+    assert q.size + fast.n_constraints <= con.DENSE_KKT_LIMIT
+    a, lam = con.multipliers(fast, t, q, v)
+    monkeypatch.setattr(con, "DENSE_KKT_LIMIT", 0)
+    a_sp, lam_sp = con.multipliers(fast, t, q, v)
+    _close(a, a_sp)
+    _close(lam, lam_sp)
+    G = fast.constraint_jacobian(t, q)
+    r = fast.residual(t, q, v, np.zeros(q.size))
+    _close(fast.mass() @ a + G.T @ lam, -r, scale=float(np.max(np.abs(r))))
+    _close(G @ a, fast.constraint_rates(t, q, v)[1])
+
+
+def test_dense_multipliers_singular_named():
+    """A KKT matrix with a repeated constraint row is refused with the sparse path's message."""
+    import ancfdae.constrained as con
+    M = sp.identity(3, format="csr")
+    G = sp.csr_matrix(np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]]))
+    with pytest.raises(np.linalg.LinAlgError, match="KKT matrix .* is singular"):
+        con._solve_dense(M, G, np.ones(5), "multipliers at t = 0")
