@@ -8,7 +8,7 @@ given (:mod:`ancfdae.joints`). The equations are ``r(t, q, v, a) + G^T lam = 0``
 """
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import scipy.sparse as sp
@@ -157,7 +157,7 @@ class System(BodyStack):
             shifted.append(sp.csr_matrix((B.data, B.indices + o, B.indptr), shape=(B.shape[0], n)))
         return sp.vstack(shifted + [joint_part], format="csr")
 
-    def constraint_terms_at(self, t: float):
+    def constraint_terms_at(self, t: float) -> Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]:
         """``(q, lam) -> (g(t, q), G(t, q)^T lam)`` at the time ``t`` (an index-3 step's residuals): one compiled
         pass, the time functions evaluated once, when every row is folded; else :meth:`constraints` and
         :meth:`constraint_force`."""
@@ -165,7 +165,7 @@ class System(BodyStack):
             return self._joint_set.terms_at(t)
         return lambda q, lam: (self.constraints(t, q), self.constraint_force(t, q, lam))
 
-    def constraint_position_terms_at(self, t: float):
+    def constraint_position_terms_at(self, t: float) -> Callable[[np.ndarray], tuple]:
         """``q -> (g, G, g_t)`` at the time ``t`` (a GGL stage's rows): one compiled pass when every row is
         folded, else :meth:`constraints`, :meth:`constraint_jacobian` and :meth:`constraint_rates`."""
         if not self._body_rows and hasattr(self._joint_set, "position_terms_at"):

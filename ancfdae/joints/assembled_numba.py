@@ -15,7 +15,10 @@ most of its time there (``python -m benchmarks.multibody_vs_exudyn``, profile in
 """
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
+import scipy.sparse as sp
 from numba import njit
 
 from ancfdae.joints.assembled import ConstraintSet
@@ -113,7 +116,7 @@ class CompiledConstraintSet(ConstraintSet):
         # the pattern is canonical and fixed: skip scipy's format checks (~25 us a matrix)
         return _fast_csr(data, pattern.indices, pattern.indptr, pattern.shape)
 
-    def terms_at(self, t: float):
+    def terms_at(self, t: float) -> Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]:
         """``(q, lam) -> (g(t, q), G(t, q)^T lam)`` with the time functions evaluated once, at ``t`` (the
         residuals of a step's Newton iterations share its time; evaluating them cost 8-15 us a call on B6)."""
         w, args = self.weights(t)[0], (*self._lin, *self._const, *self._quad)
@@ -129,7 +132,7 @@ class CompiledConstraintSet(ConstraintSet):
         """``(g(t, q), G(t, q)^T lam)`` in one call."""
         return self.terms_at(t)(q, lam)
 
-    def position_terms_at(self, t: float):
+    def position_terms_at(self, t: float) -> Callable[[np.ndarray], tuple]:
         """``q -> (g, G, g_t)`` at ``t`` with the time functions evaluated once (a GGL stage's rows)."""
         w = self.weights(t)
         args = (w[0], w[1], self.lin_term, self.lin_row, self.lin_col, self.lin_slot, self.lin_val,
@@ -142,7 +145,7 @@ class CompiledConstraintSet(ConstraintSet):
             return g, self._csr(pattern, data), gt
         return terms
 
-    def position_terms(self, t: float, q: np.ndarray):
+    def position_terms(self, t: float, q: np.ndarray) -> tuple:
         """``(g, G, g_t)`` at ``(t, q)`` in one call."""
         return self.position_terms_at(t)(q)
 
@@ -160,15 +163,15 @@ class CompiledConstraintSet(ConstraintSet):
                        np.asarray(x, dtype=float), data)
         return self._csr(self.G_pattern, data)
 
-    def G(self, t: float, q: np.ndarray):
+    def G(self, t: float, q: np.ndarray) -> sp.csr_matrix:
         """``G = dg/dq`` on the fixed pattern, shape (m, n)."""
         return self._matrix(self.weights(t)[0], q)
 
-    def velocity_jacobian(self, t: float, q: np.ndarray, v: np.ndarray):
+    def velocity_jacobian(self, t: float, q: np.ndarray, v: np.ndarray) -> sp.csr_matrix:
         """``d(G v + g_t)/dq = Z(v) + G_t`` on G's pattern."""
         return self._matrix(self.weights(t)[1], v)
 
-    def H(self, lam: np.ndarray):
+    def H(self, lam: np.ndarray) -> sp.csr_matrix:
         """``d(G^T lam)/dq = sum_i lam_i A_i`` on the fixed pattern, shape (n, n)."""
         data = np.empty(self.H_pattern.nnz)
         _h_data(self._h_slot, self.qi, self.qa, np.asarray(lam, dtype=float), data)

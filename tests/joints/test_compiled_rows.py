@@ -5,9 +5,10 @@ compiled set (:mod:`ancfdae.joints.assembled_numba`); ``kernel="numpy"`` evaluat
 by body and the joints' in NumPy. On the B5, B6 and B7 models at random states (off the constraints, so
 every quadratic term counts) and at times inside the drives' ramps (``phi'`` and ``phi''`` non-zero) the two
 must agree in ``g``, ``G``, ``G^T lam``, ``d(G^T lam)/dq``, ``(g_t, gamma)``, ``Z(v) + G_t``, the one-pass
-``(g, G^T lam)``, the one-pass ``(g, G, g_t)`` of a GGL stage and the KKT matrix. Caught: a quadratic entry dropped or halved in one kernel, a body's
-row folded with the wrong offset, sign or constant, a time derivative taken from the wrong weight row,
-``G_t v`` without its factor 2, rows reordered (labels and values). Not caught here: a defect the two paths
+``(g, G^T lam)``, the one-pass ``(g, G, g_t)`` of a GGL stage and the KKT matrix. Caught: a quadratic
+entry dropped or halved in one kernel, a body's row folded with the wrong offset, sign or constant, a time
+derivative taken from the wrong weight row, ``G_t v`` without its factor 2, rows reordered (labels and
+values). Not caught here: a defect the two paths
 share (a joint's wrong row): ``test_joint_derivatives.py`` checks the rows against finite differences.
 The multipliers at output times (dense KKT solve for small systems) against the sparse solve.
 """
