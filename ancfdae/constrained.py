@@ -74,10 +74,36 @@ def multipliers(model, t: float, q: np.ndarray, v: np.ndarray, *,
     n = q.size
     r0 = np.asarray(model.residual(t, q, v, np.zeros(n)), dtype=float)
     _, gamma = model.constraint_rates(t, q, v)
-    x = _solve(kkt_matrix(model.mass(q), model.constraint_jacobian(t, q), assembler=assembler),
-               np.concatenate([-r0, gamma]),
-               f"multipliers at t = {t:g}")
+    M, G, what = model.mass(q), model.constraint_jacobian(t, q), f"multipliers at t = {t:g}"
+    rhs = np.concatenate([-r0, gamma])
+    if n + G.shape[0] <= DENSE_KKT_LIMIT:
+        x = _solve_dense(M, G, rhs, what)
+    else:
+        x = _solve(kkt_matrix(M, G, assembler=assembler), rhs, what)
     return x[:n], x[n:]
+
+
+#: largest KKT system (n + m) :func:`multipliers` solves densely (LAPACK): at the sizes of B5/B6 (39, 62
+#: unknowns) the sparse assembly and SuperLU took about 1 ms an output time, the dense solve 0.1 ms
+DENSE_KKT_LIMIT = 128
+
+
+def _solve_dense(M, G, rhs, what):
+    """``[[M, G^T], [G, 0]] x = rhs`` by a dense LU (small systems), with the errors of :func:`_solve`."""
+    n, m = M.shape[0], G.shape[0]
+    K = np.zeros((n + m, n + m))
+    K[:n, :n] = M.toarray() if sp.issparse(M) else M
+    Gd = G.toarray() if sp.issparse(G) else np.asarray(G, dtype=float)
+    K[n:, :n] = Gd
+    K[:n, n:] = Gd.T
+    try:
+        x = np.linalg.solve(K, rhs)
+    except np.linalg.LinAlgError as exc:
+        raise np.linalg.LinAlgError(f"{what}: the KKT matrix [[M, G^T], [G, 0]] is singular ({exc}); "
+                                    "are constraints redundant (see ancfdae.constrained.dependent_rows)?") from None
+    if not np.all(np.isfinite(x)):
+        raise np.linalg.LinAlgError(f"{what}: the KKT solve gave non-finite values (singular matrix?)")
+    return x
 
 
 def project_positions(model, t: float, q0: np.ndarray, *, tol: float = 1e-14,

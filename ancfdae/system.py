@@ -8,7 +8,7 @@ given (:mod:`ancfdae.joints`). The equations are ``r(t, q, v, a) + G^T lam = 0``
 """
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import scipy.sparse as sp
@@ -23,6 +23,20 @@ from ancfdae.system_stack import BodyStack
 __all__ = ["System"]
 
 
+def _quadratic_rows(body, offset: int, n: int) -> Rows:
+    """A body's constraint rows ``1/2 q^T A_r q + b_r . q + c_r`` (its ``constraint_quadratic_form``) placed at
+    ``offset`` in the system's ``n`` coordinates."""
+    A, b, c = body.constraint_quadratic_form()
+    nb = body.n_dof
+    place = sp.csr_matrix((np.ones(nb), (np.arange(nb), offset + np.arange(nb))), shape=(nb, n))
+    rows = Rows(n)
+    b = sp.csr_matrix(b)
+    for r in range(len(A)):
+        Ar = sp.csr_matrix(place.T @ sp.csr_matrix(A[r]) @ place)
+        rows.add(f"body row {r}", b[r] @ place, float(c[r]), Ar if Ar.nnz else None)
+    return rows
+
+
 class System(BodyStack):
     """Bodies (each a Model: :class:`~ancfdae.models.Beam`, a rigid body) joined by joints.
 
@@ -35,6 +49,12 @@ class System(BodyStack):
         :mod:`ancfdae.joints` objects.
     t0 : float
         Time of the initial state, where ground points default and the rank of ``G`` is checked.
+    kernel : {"auto", "numba", "numpy"}
+        How the constraint rows are evaluated. ``"auto"`` / ``"numba"``: every row of the joints and of the
+        bodies that give their rows' quadratic form (``constraint_quadratic_form``: rigid bodies) in one
+        compiled pass on fixed patterns (:mod:`ancfdae.joints.assembled_numba`); ``"numpy"``: the readable
+        reference, body by body and the joints' rows in NumPy (:mod:`ancfdae.joints.assembled`). Both give
+        the same values to round-off and the same row order.
 
     Attributes
     ----------
@@ -51,8 +71,12 @@ class System(BodyStack):
         joints (rows of ``G`` that depend on earlier rows at the initial state: named).
     """
 
-    def __init__(self, bodies: Sequence, joints: Sequence[Joint] = (), *, t0: float = 0.0) -> None:
+    def __init__(self, bodies: Sequence, joints: Sequence[Joint] = (), *, t0: float = 0.0,
+                 kernel: str = "auto") -> None:
         super().__init__(bodies)
+        if kernel not in ("auto", "numba", "numpy"):
+            raise ValueError(f"`kernel` must be 'auto', 'numba' or 'numpy', got {kernel!r}.")
+        self.kernel = kernel
         joints = list(joints)
         for k, j in enumerate(joints):
             if not isinstance(j, Joint):
@@ -64,14 +88,28 @@ class System(BodyStack):
         for k, joint in enumerate(joints):
             frames = tuple(self._frame(k, joint, arg, side) for arg, side in zip(joint.side_args, joint.sides))
             rows.extend(joint.rows(frames, q0, n))
-        self._joint_set = ConstraintSet(rows)
-        self._body_rows = [(b, off, b.n_constraints) for b, off in zip(self.bodies, self.offsets)
-                           if "constraints" in capabilities(b)]
-        self.n_constraints = sum(m for _, _, m in self._body_rows) + self._joint_set.m
+        body_rows = [(b, off, b.n_constraints) for b, off in zip(self.bodies, self.offsets)
+                     if "constraints" in capabilities(b)]
+        self.n_constraints = sum(m for _, _, m in body_rows) + rows.m
         self.constraint_labels = tuple(
-            [f"body {self.bodies.index(b)}: {lab}" for b, _, m in self._body_rows
+            [f"body {self.bodies.index(b)}: {lab}" for b, _, m in body_rows
              for lab in getattr(b, "constraint_labels", [f"row {i}" for i in range(m)])]
-            + list(self._joint_set.labels))
+            + list(rows.labels))
+        # compiled: the bodies' quadratic rows go first into the one set of rows (the order of the labels)
+        fold = kernel != "numpy" and all(callable(getattr(b, "constraint_quadratic_form", None))
+                                         for b, _, _ in body_rows)
+        if fold:
+            folded = Rows(n)
+            for b, off, _ in body_rows:
+                folded.extend(_quadratic_rows(b, off, n))
+            folded.extend(rows)
+            rows, body_rows = folded, []
+        if kernel == "numpy":
+            self._joint_set = ConstraintSet(rows)
+        else:
+            from ancfdae.joints.assembled_numba import CompiledConstraintSet
+            self._joint_set = CompiledConstraintSet(rows)
+        self._body_rows = body_rows   # the bodies whose rows are evaluated body by body
         if self.n_constraints:
             drop = dependent_rows(self.constraint_jacobian(t0, q0))
             if drop:
@@ -118,6 +156,22 @@ class System(BodyStack):
             B = sp.csr_matrix(B)
             shifted.append(sp.csr_matrix((B.data, B.indices + o, B.indptr), shape=(B.shape[0], n)))
         return sp.vstack(shifted + [joint_part], format="csr")
+
+    def constraint_terms_at(self, t: float) -> Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]:
+        """``(q, lam) -> (g(t, q), G(t, q)^T lam)`` at the time ``t`` (an index-3 step's residuals): one compiled
+        pass, the time functions evaluated once, when every row is folded; else :meth:`constraints` and
+        :meth:`constraint_force`."""
+        if not self._body_rows and hasattr(self._joint_set, "terms_at"):
+            return self._joint_set.terms_at(t)
+        return lambda q, lam: (self.constraints(t, q), self.constraint_force(t, q, lam))
+
+    def constraint_position_terms_at(self, t: float) -> Callable[[np.ndarray], tuple]:
+        """``q -> (g, G, g_t)`` at the time ``t`` (a GGL stage's rows): one compiled pass when every row is
+        folded, else :meth:`constraints`, :meth:`constraint_jacobian` and :meth:`constraint_rates`."""
+        if not self._body_rows and hasattr(self._joint_set, "position_terms_at"):
+            return self._joint_set.position_terms_at(t)
+        return lambda q: (self.constraints(t, q), self.constraint_jacobian(t, q),
+                          self.constraint_rates(t, q, np.zeros_like(q))[0])
 
     def constraint_jacobian(self, t: float, q: np.ndarray) -> sp.csr_matrix:
         """``G = dg/dq`` on a fixed pattern, shape (n_constraints, n_dof)."""

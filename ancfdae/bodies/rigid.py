@@ -245,6 +245,11 @@ class RigidBody:
         check_shape("lam", lam, (self.n_constraints,), f"n_constraints = {self.n_constraints}")
         return self._ortho.constraint_force_jacobian(t, q, lam)
 
+    def constraint_quadratic_form(self) -> tuple[list, sp.csr_matrix, np.ndarray]:
+        """The orthonormality rows as ``1/2 q^T A_r q + b_r . q + c_r`` with constant ``A_r, b, c`` and no time
+        (:meth:`.orthonormality.Orthonormality.quadratic_form`): what a System folds into its compiled rows."""
+        return self._ortho.quadratic_form()
+
     def constraint_rates(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(g_t, gamma)`` of ``G v + g_t = 0``, ``G a = gamma``."""
         self._check(q, v)

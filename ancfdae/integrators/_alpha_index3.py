@@ -33,7 +33,7 @@ import scipy.sparse as sp
 
 from ancfdae.integrators.protocol import StepOutcome
 
-__all__ = ["index3_step", "index3_equations", "mass_scale", "constraint_force"]
+__all__ = ["index3_step", "index3_equations", "mass_scale", "constraint_force", "constraint_terms"]
 
 
 def mass_scale(M) -> float:
@@ -48,6 +48,16 @@ def constraint_force(model):
     if callable(fast):
         return fast
     return lambda t, q, lam: model.constraint_jacobian(t, q).T @ lam
+
+
+def constraint_terms(model, t: float):
+    """``(q, lam) -> (g(t, q), G(t, q)^T lam)``: the model's one-pass fast path at ``t`` when it has one (a
+    compiled :class:`ancfdae.System`), else ``constraints`` and :func:`constraint_force`."""
+    fast = getattr(model, "constraint_terms_at", None)
+    if callable(fast):
+        return fast(t)
+    force = constraint_force(model)
+    return lambda q, lam: (model.constraints(t, q), force(t, q, lam))
 
 
 def index3_equations(st, t: float, h: float):
@@ -71,12 +81,12 @@ def index3_equations(st, t: float, h: float):
         a1 = s * y + const_a          # ((1 - am) ah1 + am ah0 - af a0) / (1 - af), ah1 = y / (beta h^2)
         return q1, v1, a1, sm * x[n:]
 
-    force = constraint_force(model)
+    terms = constraint_terms(model, t1)
 
     def residual(x):
         q1, v1, a1, lam = state(x)
-        dyn = np.asarray(model.residual(t1, q1, v1, a1), dtype=float) + force(t1, q1, lam)
-        return np.concatenate([dyn, sm * model.constraints(t1, q1)])
+        g, f = terms(q1, lam)
+        return np.concatenate([np.asarray(model.residual(t1, q1, v1, a1), dtype=float) + f, sm * g])
 
     def jacobian(x):
         q1, v1, a1, lam = state(x)

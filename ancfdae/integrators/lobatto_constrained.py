@@ -114,6 +114,7 @@ class GGLStages:
         self.inv_perm = np.empty_like(self.perm)
         self.inv_perm[self.perm] = np.arange(self.perm.size)
         self.stages = model.residual_stages if "residual_stages" in capabilities(model) else None
+        self._stage_terms = None    # per stage: q -> (g, G, g_t) at its time, when the model offers it
 
     def _ordering(self, G):
         """Permutation of ``[A (n ns), Lam (m ns), U (m ns)]`` (stage copies interleaved): each
@@ -158,6 +159,9 @@ class GGLStages:
         self.Q0 = st.q[:, None] + h * np.outer(st.v, self.a_first)
         self.V0 = st.v[:, None] + h * np.outer(st.a, self.a_first)
         self.haT = h * self.a.T
+        # (g, G, g_t) of a stage in one pass, time functions evaluated once a step (a compiled System)
+        at = getattr(st.model, "constraint_position_terms_at", None)
+        self._stage_terms = [at(ti) for ti in self.ts] if callable(at) else None
 
     def states(self, x, t, h):
         """Stage times, ``Q, V, A, Lam, U`` at the unknowns ``x`` of the step ``(t, h)``."""
@@ -188,9 +192,12 @@ class GGLStages:
             q, v = Q[:, i], V[:, i]
             if self.stages is None:
                 RD[:, i] = model.residual(ts[i], q, v, A[:, i])
-            G = as_csr(model.constraint_jacobian(ts[i], q))
-            g = np.asarray(model.constraints(ts[i], q), dtype=float)
-            g_t = np.asarray(model.constraint_rates(ts[i], q, v)[0], dtype=float)
+            if self._stage_terms is not None:
+                g, G, g_t = self._stage_terms[i](q)
+            else:
+                G = as_csr(model.constraint_jacobian(ts[i], q))
+                g = np.asarray(model.constraints(ts[i], q), dtype=float)
+                g_t = np.asarray(model.constraint_rates(ts[i], q, v)[0], dtype=float)
             ggl_stage_rows(out, i, n, self.m, ns, ms, h, G.indptr, G.indices, G.data.astype(float, copy=False),
                            K, V, U, L, g, g_t)
         return out

@@ -93,6 +93,32 @@ class ConstraintSet:
         self._timed_T = [sp.csr_matrix(Bj.T) for _, Bj, _ in self.timed]
         self.H_pattern = _pattern((n, n), self.qj, self.qk)
         self._h_slot = _slots(self.H_pattern, self.qj, self.qk)
+        self._flatten()
+
+    def _flatten(self) -> None:
+        """Every linear entry and constant of (R) as one list with a *term* index: term 0 is the scleronomic
+        part (weight 1), term ``j + 1`` the rheonomic ``phi_j(t)`` (weights: :meth:`weights`). The compiled
+        twin (:mod:`.assembled_numba`) evaluates every quantity from these arrays in one pass."""
+        lin = [(0, self.B.tocoo())] + [(j + 1, sp.coo_matrix(Bj)) for j, (_, Bj, _) in enumerate(self.timed)]
+        self.lin_term = np.concatenate([np.full(C.nnz, k, dtype=np.int64) for k, C in lin])
+        self.lin_row = np.concatenate([C.row.astype(np.int64) for _, C in lin])
+        self.lin_col = np.concatenate([C.col.astype(np.int64) for _, C in lin])
+        self.lin_val = np.concatenate([C.data.astype(float) for _, C in lin])
+        self.lin_slot = _slots(self.G_pattern, self.lin_row, self.lin_col)
+        consts = [(0, self.c)] + [(j + 1, cj) for j, (_, _, cj) in enumerate(self.timed)]
+        nz = [(k, np.flatnonzero(c), c) for k, c in consts]
+        self.const_term = np.concatenate([np.full(i.size, k, dtype=np.int64) for k, i, _ in nz])
+        self.const_row = np.concatenate([i.astype(np.int64) for _, i, _ in nz])
+        self.const_val = np.concatenate([c[i] for _, i, c in nz]).astype(float)
+
+    def weights(self, t: float) -> np.ndarray:
+        """``w`` (3, 1 + number of timed terms): row ``d`` the ``d``-th time derivative of each term's factor
+        (term 0 is 1, so its derivatives are 0)."""
+        w = np.zeros((3, 1 + len(self.timed)))
+        w[0, 0] = 1.0
+        for j, ph in enumerate(self._phis(t)):
+            w[:, j + 1] = ph
+        return w
 
     # -- evaluation ----------------------------------------------------------------------------
     def _csr(self, pattern, data):
