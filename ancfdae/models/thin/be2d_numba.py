@@ -19,9 +19,11 @@ from numba import njit
 from ..beam.assembly_numba import gather_elements, scatter
 from ...integrators._affine import affine3
 from ..beam.iteration_numba import alpha_finish, alpha_update, carry_on
+from ...integrators._alpha_steps_numba import alpha_steps
 from ..element import Kernel
 
-__all__ = ["BE2DCompiled", "be2d_forces", "be2d_fused", "be2d_alpha_iterations", "STRUCTURAL", "CONTINUUM"]
+__all__ = ["BE2DCompiled", "be2d_forces", "be2d_fused", "be2d_alpha_iterations", "be2d_alpha_steps", "STRUCTURAL",
+           "CONTINUUM"]
 
 STRUCTURAL, CONTINUUM = 0, 1
 
@@ -186,6 +188,12 @@ def be2d_alpha_iterations(x, r, err, max_k, contraction, threshold, lub, kl, ku,
         err = err_new
 
 
+@njit(cache=True)
+def be2d_alpha_steps(S, P, fpar, ipar, out, lub, piv, gravity, dead, scales, arrays, element_args):
+    """Newmark-family steps in one call (contract in :mod:`ancfdae.integrators._alpha_steps_numba`)."""
+    alpha_steps(be2d_alpha_iterations, S, P, fpar, ipar, out, lub, piv, gravity, dead, scales, arrays, element_args)
+
+
 class BE2DCompiled(Kernel):
     """The compiled kernel object of BE2D: :func:`be2d_forces` and the fused entry point :func:`be2d_fused`."""
 
@@ -216,3 +224,7 @@ class BE2DCompiled(Kernel):
     def alpha_iterations(self, geom: dict) -> tuple:
         """``(be2d_alpha_iterations, args)``: compiled Newton iterations (:mod:`ancfdae.models.beam.iteration_numba`)."""
         return be2d_alpha_iterations, self._args(geom)
+
+    def alpha_steps(self, geom: dict) -> tuple:
+        """``(be2d_alpha_steps, args)``: compiled whole steps (:mod:`ancfdae.integrators._alpha_steps_numba`)."""
+        return be2d_alpha_steps, self._args(geom)
