@@ -82,31 +82,36 @@ def be2d_forces(q, dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4, tangent)
         if tangent:
             Ku[:] = 0.0
         for p in range(n_pts):
-            # r' and r'' at the point
+            # r' (and r'' at a bending point) at the point
+            axial = p < n_a
             r1x = r1y = r2x = r2y = 0.0
             for k in range(4):
                 r1x += dN[e, p, k] * q[e, 2 * k]
                 r1y += dN[e, p, k] * q[e, 2 * k + 1]
-                r2x += ddN[e, p, k] * q[e, 2 * k]
-                r2y += ddN[e, p, k] * q[e, 2 * k + 1]
             g = r1x * r1x + r1y * r1y
             wp = w[e, p]
-            axial = p < n_a
             if axial:
                 Wg, Wgg = _densities_axial(form, g, eps_ref[e, p], EA)
                 Wc = Wgc = Wcc = 0.0
+                for k in range(4):
+                    a = dN[e, p, k]
+                    dg[2 * k] = 2.0 * a * r1x
+                    dg[2 * k + 1] = 2.0 * a * r1y
             else:
+                for k in range(4):
+                    r2x += ddN[e, p, k] * q[e, 2 * k]
+                    r2y += ddN[e, p, k] * q[e, 2 * k + 1]
                 c = r1x * r2y - r1y * r2x
                 Wg, Wc, Wgg, Wgc, Wcc = _densities_bending(form, g, c, K_ref[e, p], E, I, I4)
-            for k in range(4):
-                a, b = dN[e, p, k], ddN[e, p, k]
-                dg[2 * k] = 2.0 * a * r1x
-                dg[2 * k + 1] = 2.0 * a * r1y
-                # dc = Sx^T P r'' + Sxx^T P^T r'
-                dc[2 * k] = a * r2y - b * r1y
-                dc[2 * k + 1] = -a * r2x + b * r1x
+                for k in range(4):
+                    a, b = dN[e, p, k], ddN[e, p, k]
+                    dg[2 * k] = 2.0 * a * r1x
+                    dg[2 * k + 1] = 2.0 * a * r1y
+                    # dc = Sx^T P r'' + Sxx^T P^T r'
+                    dc[2 * k] = a * r2y - b * r1y
+                    dc[2 * k + 1] = -a * r2x + b * r1x
             wg, wc = wp * Wg, wp * Wc
-            if axial:   # W depends on g alone here: dc terms vanish
+            if axial:   # W depends on g alone here: r'' and dc do not enter
                 for i in range(8):
                     f[e, i] += dg[i] * wg
             else:
