@@ -32,7 +32,9 @@ The loop is the integrator's (this module); the element's file holds only the ca
 caches a function on disk only when the entry point it calls is a compile-time constant (see
 :mod:`ancfdae.models.beam.iteration_numba`): :func:`alpha_steps` is inlined into that call (numba's
 ``inline="always"``), where the entry point is a global name; passed as a value to a separate
-function it becomes a pointer to the dispatcher object, which numba refuses to cache. Each step is exactly the Python path's -- :meth:`ancfdae.integrators.FixedStepIntegrator.next_time`,
+function it becomes a pointer to the dispatcher object, which numba refuses to cache. numba keys that cache
+on the element's file alone: after editing this module, delete the element's ``*.nbi``/``*.nbc`` files (e.g.
+``ancfdae/models/thin/__pycache__/be2d_numba.be2d_alpha_steps-*``), or the old loop runs on. Each step is exactly the Python path's -- :meth:`ancfdae.integrators.FixedStepIntegrator.next_time`,
 :meth:`ancfdae.integrators.newmark._AlphaFamily._step_impl`,
 :meth:`ancfdae.integrators._newton.NewtonSolver.solve` with a cached (stale) matrix -- as long as no
 decision needs Python: a step-size change (the matrix is rebuilt), a residual or correction that is
