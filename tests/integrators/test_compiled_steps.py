@@ -78,6 +78,19 @@ def test_compiled_steps_are_used(monkeypatch):
     assert sum(taken) > res.stats["steps"] // 2
 
 
+def test_a_long_stretch_without_outputs_returns_to_python_now_and_then(monkeypatch):
+    # Catches: one compiled call for the whole run (Ctrl-C and the progress bar wait until it ends).
+    monkeypatch.setattr(_alpha_steps, "STEPS_PER_CALL", 7)
+    fast, slow = _both(_beam(), monkeypatch, "generalized-alpha", 0.03, h=1e-3, t_eval=[0.03])
+    _same(fast, slow)
+    calls = []
+    run = _alpha_steps.AlphaSteps.run
+    monkeypatch.setattr(_alpha_steps.AlphaSteps, "run", lambda self, *a: calls.append(1) or run(self, *a))
+    monkeypatch.setattr(_alpha_steps, "STEPS_PER_CALL", 7)
+    simulate(_beam(), (0.0, 0.03), "generalized-alpha", h=1e-3, t_eval=[0.03])
+    assert len(calls) >= 30 // 7
+
+
 def test_failure_inside_the_steps_keeps_the_outputs(monkeypatch):
     # the dead load turns NaN at t = 0.0131: the compiled steps hand that step to Python, which fails it
     def time(t):
