@@ -70,6 +70,8 @@ def force_scale(model, t: float, q: np.ndarray, v: np.ndarray | None = None, a: 
     J = model.jacobian(t, q, v, a)
 
     def amax(x):
+        if sp.issparse(x):   # the stored entries (implicit zeros cannot raise a max of |.|): no new matrix
+            return float(np.abs(x.data).max()) if x.nnz else 0.0
         x = abs(x)
         return float(x.max()) if x.shape[0] else 0.0
     r = model.residual(t, q, z, z)

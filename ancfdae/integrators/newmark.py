@@ -42,6 +42,7 @@ from ancfdae.integrators._affine import affine2, affine3, newmark_predict
 from ancfdae.integrators._alpha_index3 import index3_step, mass_scale
 from ancfdae.kkt import KKTAssembler
 from ancfdae.integrators._alpha_iteration import AlphaIteration
+from ancfdae.integrators._alpha_steps import AlphaSteps
 from ancfdae.integrators._newton_records import NewtonOptions
 from ancfdae.integrators.driver import consistent_acceleration
 from ancfdae.integrators.newton_stepper import NewtonStepper
@@ -69,6 +70,7 @@ class _AlphaFamily(NewtonStepper):
         super().__init__(model, h, newton=newton)
         self.beta, self.gamma, self.alpha_m, self.alpha_f = beta, gamma, alpha_m, alpha_f
         self._offer = (None, None)   # (model, its compiled_residual), taken at the first step of a run
+        self._steps = (None, None)   # (model, its AlphaSteps or None), made at the first steps_until of a run
 
     def options(self) -> dict:
         """The options as a JSON-able dict (stored in the Result).
@@ -86,7 +88,7 @@ class _AlphaFamily(NewtonStepper):
         """The Newton set-up (the model's compiled offer taken afresh); on a constrained model the algorithmic
         acceleration starts at ``a0``."""
         super()._setup()
-        self._offer = (None, None)
+        self._offer = self._steps = (None, None)
         self._constrained = "constraints" in capabilities(self.model)
         if self._constrained:
             self._ah = self.a.copy()
@@ -159,6 +161,49 @@ class _AlphaFamily(NewtonStepper):
         x = out.x
         q, v = affine2(q_pred, v_pred, cq, cv, x)
         return StepOutcome(ok=True, t=t + h, q=q, v=v, a=x)
+
+    def steps_until(self, t_stop: float, max_count: int) -> tuple[StepOutcome, int]:
+        """Steps up to the first that reaches ``t_stop``, in one compiled call where the model offers it.
+
+        The driver calls this instead of :meth:`step` when nothing needs the state between its stops
+        (:mod:`ancfdae.integrators._alpha_steps`). Of the steps taken, all but the last are accepted
+        here; the last one's outcome is returned for the driver to accept, as from :meth:`step` (a
+        failure: the step after the accepted ones failed). Without the compiled path (a user's model,
+        point moments, constraints, full Newton, no cached banded factors yet) it is one :meth:`step`.
+
+        Parameters
+        ----------
+        t_stop : float
+            The driver's next output time (or the end of the run).
+        max_count : int
+            At most this many steps, the returned one included (>= 1).
+
+        Returns
+        -------
+        outcome : StepOutcome
+            The last step's outcome, not yet accepted.
+        taken : int
+            Steps accepted here before it.
+        """
+        steps = self._compiled_steps()
+        lu = self.newton._lu
+        band = getattr(lu, "_lu", None)
+        if (steps is None or max_count < 1 or self._h_matrix is None or getattr(band, "lub", None) is None
+                or not band._compiled or band.dtype != np.float64):
+            return self.step(), 0
+        return steps.run(band, float(t_stop), int(max_count))
+
+    def _compiled_steps(self):
+        """The model's compiled steps (:class:`._alpha_steps.AlphaSteps`) for this run, or None."""
+        if self._constrained or self.newton.options.jacobian != "modified":
+            return None
+        model = self.model.wrapped
+        if self._steps[0] is not model:
+            offer = getattr(model, "compiled_residual", None)
+            compiled = offer() if offer is not None else None
+            made = AlphaSteps(compiled, self) if compiled is not None and compiled.steps is not None else None
+            self._steps = (model, made)
+        return self._steps[1]
 
     def _compiled_iteration(self, ta, qa0, va0, aa0, cqa, cva, caa):
         """The step's iteration as one compiled call (:mod:`._alpha_iteration`) when the model offers a compiled

@@ -115,6 +115,16 @@ class Stepper(Protocol):
     stats : dict
         Work counters since ``initialize``, at least ``steps``; the driver adds its own keys
         (``model_events``, ``restarts``, ``wall_time``, ``cpu_time``) and never overwrites these.
+
+    Notes
+    -----
+    Optional: ``steps_until(t_stop, max_count) -> (outcome, taken)``. When nothing needs the state
+    between output times (``t_eval`` given, no monitor, no hook, no model event), the driver calls it
+    instead of ``step``: the stepper takes up to ``max_count`` steps, stopping after the first whose end
+    reaches ``t_stop`` (the next output time, as the driver tests it, or the end of the run); it
+    accepts all but the last itself (``taken`` of them) and returns the last one's outcome (or the
+    failure of the step after the accepted ones) for the driver to check and accept. The Newmark family
+    runs them as one compiled call (:mod:`ancfdae.integrators._alpha_steps`).
     """
 
     name: str

@@ -38,6 +38,12 @@ class CompiledResidual:
         ``external(t) -> f_ext`` (free vector): gravity plus the dead loads at ``t``.
     load_factor : float
         ``lambda``.
+    steps : numba dispatcher or None
+        The element's whole-steps entry point (contract in :mod:`ancfdae.integrators._alpha_steps_numba`), if any.
+    gravity : ndarray (n_dof,)
+        Gravity's free force vector.
+    dead : ndarray (m, n_dof)
+        The dead loads' free force vectors, ``dead_times`` their time functions (in the loads' order).
     """
 
     iterations: Callable
@@ -45,6 +51,10 @@ class CompiledResidual:
     element_args: tuple
     external: Callable
     load_factor: float
+    steps: Callable | None = None
+    gravity: np.ndarray | None = None
+    dead: np.ndarray | None = None
+    dead_times: tuple = ()
 
 
 # the beam is named, not imported: beam.py imports this module
@@ -62,4 +72,9 @@ def compiled_residual(beam: "ancfdae.models.Beam") -> CompiledResidual | None:
         return np.ascontiguousarray(loads.external(t, None, beam.geom, False)[0], dtype=float)
 
     arrays = (beam._q_fixed, beam._gather, asm._vec_all, asm._slot_all, beam._M_data, asm.indptr, asm.indices)
-    return CompiledResidual(fn, arrays, tuple(element_args), external, float(beam.load_factor))
+    steps = getattr(beam.element.kernels, "alpha_steps", None)
+    dead = np.array([vec for _, vec in loads.dead], dtype=float).reshape(len(loads.dead), loads.n_dof)
+    return CompiledResidual(fn, arrays, tuple(element_args), external, float(beam.load_factor),
+                            steps(beam.geom)[0] if steps is not None else None,
+                            np.ascontiguousarray(loads.gravity, dtype=float), np.ascontiguousarray(dead),
+                            tuple(time for time, _ in loads.dead))

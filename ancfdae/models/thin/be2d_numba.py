@@ -19,9 +19,11 @@ from numba import njit
 from ..beam.assembly_numba import gather_elements, scatter
 from ...integrators._affine import affine3
 from ..beam.iteration_numba import alpha_finish, alpha_update, carry_on
+from ...integrators._alpha_steps_numba import alpha_steps
 from ..element import Kernel
 
-__all__ = ["BE2DCompiled", "be2d_forces", "be2d_fused", "be2d_alpha_iterations", "STRUCTURAL", "CONTINUUM"]
+__all__ = ["BE2DCompiled", "be2d_forces", "be2d_fused", "be2d_alpha_iterations", "be2d_alpha_steps", "STRUCTURAL",
+           "CONTINUUM"]
 
 STRUCTURAL, CONTINUUM = 0, 1
 
@@ -80,31 +82,36 @@ def be2d_forces(q, dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4, tangent)
         if tangent:
             Ku[:] = 0.0
         for p in range(n_pts):
-            # r' and r'' at the point
+            # r' (and r'' at a bending point) at the point
+            axial = p < n_a
             r1x = r1y = r2x = r2y = 0.0
             for k in range(4):
                 r1x += dN[e, p, k] * q[e, 2 * k]
                 r1y += dN[e, p, k] * q[e, 2 * k + 1]
-                r2x += ddN[e, p, k] * q[e, 2 * k]
-                r2y += ddN[e, p, k] * q[e, 2 * k + 1]
             g = r1x * r1x + r1y * r1y
             wp = w[e, p]
-            axial = p < n_a
             if axial:
                 Wg, Wgg = _densities_axial(form, g, eps_ref[e, p], EA)
                 Wc = Wgc = Wcc = 0.0
+                for k in range(4):
+                    a = dN[e, p, k]
+                    dg[2 * k] = 2.0 * a * r1x
+                    dg[2 * k + 1] = 2.0 * a * r1y
             else:
+                for k in range(4):
+                    r2x += ddN[e, p, k] * q[e, 2 * k]
+                    r2y += ddN[e, p, k] * q[e, 2 * k + 1]
                 c = r1x * r2y - r1y * r2x
                 Wg, Wc, Wgg, Wgc, Wcc = _densities_bending(form, g, c, K_ref[e, p], E, I, I4)
-            for k in range(4):
-                a, b = dN[e, p, k], ddN[e, p, k]
-                dg[2 * k] = 2.0 * a * r1x
-                dg[2 * k + 1] = 2.0 * a * r1y
-                # dc = Sx^T P r'' + Sxx^T P^T r'
-                dc[2 * k] = a * r2y - b * r1y
-                dc[2 * k + 1] = -a * r2x + b * r1x
+                for k in range(4):
+                    a, b = dN[e, p, k], ddN[e, p, k]
+                    dg[2 * k] = 2.0 * a * r1x
+                    dg[2 * k + 1] = 2.0 * a * r1y
+                    # dc = Sx^T P r'' + Sxx^T P^T r'
+                    dc[2 * k] = a * r2y - b * r1y
+                    dc[2 * k + 1] = -a * r2x + b * r1x
             wg, wc = wp * Wg, wp * Wc
-            if axial:   # W depends on g alone here: dc terms vanish
+            if axial:   # W depends on g alone here: r'' and dc do not enter
                 for i in range(8):
                     f[e, i] += dg[i] * wg
             else:
@@ -186,6 +193,12 @@ def be2d_alpha_iterations(x, r, err, max_k, contraction, threshold, lub, kl, ku,
         err = err_new
 
 
+@njit(cache=True)
+def be2d_alpha_steps(S, P, fpar, ipar, out, lub, piv, gravity, dead, scales, arrays, element_args):
+    """Newmark-family steps in one call (contract in :mod:`ancfdae.integrators._alpha_steps_numba`)."""
+    alpha_steps(be2d_alpha_iterations, S, P, fpar, ipar, out, lub, piv, gravity, dead, scales, arrays, element_args)
+
+
 class BE2DCompiled(Kernel):
     """The compiled kernel object of BE2D: :func:`be2d_forces` and the fused entry point :func:`be2d_fused`."""
 
@@ -216,3 +229,7 @@ class BE2DCompiled(Kernel):
     def alpha_iterations(self, geom: dict) -> tuple:
         """``(be2d_alpha_iterations, args)``: compiled Newton iterations (:mod:`ancfdae.models.beam.iteration_numba`)."""
         return be2d_alpha_iterations, self._args(geom)
+
+    def alpha_steps(self, geom: dict) -> tuple:
+        """``(be2d_alpha_steps, args)``: compiled whole steps (:mod:`ancfdae.integrators._alpha_steps_numba`)."""
+        return be2d_alpha_steps, self._args(geom)
