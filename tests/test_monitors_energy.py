@@ -135,3 +135,21 @@ def test_energy_monitor_log_and_checks():
         EnergyMonitor(stop_on_blowup="yes")
     with pytest.raises(ValueError, match="exactly one"):
         PointSensor()
+
+
+def test_point_sensor_equals_model_position_at_every_output():
+    """PointSensor builds the beam's point operator once: its positions and velocities must still be the
+    model's ``position`` at every output (catches an operator built at the wrong arc length, for the
+    wrong beam, or a velocity taken without the fixed coordinates' offset), on a clamped beam (fixed
+    coordinates enter r(s) through the reference)."""
+    beam = Beam(BE2D(Material(E=1e5, nu=0.3, rho=2500.0), RectangularSection(0.05)), n_elements=3, length=1.0,
+                supports={0: "clamp"}, loads=[PointForce((0.0, -0.5), node=-1)])
+    s = 0.7
+    res = simulate(beam, (0.0, 0.05), "generalized-alpha", h=5e-3, t_eval=np.linspace(0.0, 0.05, 6),
+                   monitors=[PointSensor(s=s)])
+    log = res.monitors[f"point@{s:g}"]
+    for k in range(res.t.size):
+        np.testing.assert_allclose(log["position"][k], beam.position(res.q[k], s), rtol=0, atol=1e-15)
+        np.testing.assert_allclose(log["velocity"][k], beam.position(res.q[k] + res.v[k], s)
+                                   - beam.position(res.q[k], s), rtol=0, atol=1e-15)
+    assert np.ptp(log["position"][:, 1]) > 1e-4   # the point moved: equality is not of constants

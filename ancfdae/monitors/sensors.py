@@ -49,12 +49,23 @@ class PointSensor(Monitor):
                             "none: pass `function=` instead.")
         self.model = model
         self._pos, self._vel = [], []
+        # A beam's axis point is r(s) = P expand(q) with P fixed: build P once, not at every output (rebuilding
+        # it cost ~30 % of a profiled IDA run on B2). Other models keep model.position.
+        self._P = None
+        if self.s is not None and callable(getattr(model, "point_matrix", None)) \
+                and callable(getattr(model, "expand", None)):
+            self._P = model.point_matrix(self.s)
+
+    def _position(self, q: np.ndarray) -> np.ndarray:
+        if self._P is None:
+            return np.asarray(self.model.position(q, self.s), dtype=float)
+        return self._P @ self.model.expand(q)
 
     def sample(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> None:
         if self.s is not None:
-            p = np.asarray(self.model.position(q, self.s), dtype=float)
+            p = self._position(q)
             self._pos.append(p)
-            self._vel.append(np.asarray(self.model.position(q + v, self.s), dtype=float) - p)
+            self._vel.append(self._position(q + v) - p)
         else:
             self._pos.append(np.atleast_1d(np.asarray(self.function(q), dtype=float)))
             if self.velocity_function is not None:
