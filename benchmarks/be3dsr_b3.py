@@ -55,7 +55,7 @@ def long_run(n: int, t_end: float, segment: float, out: str | None, dt_out: floa
     beam = b3_beam("BE3DSR", n)
     q, v = beam.initial_state()
     state = beam.event_state()
-    t0, work, cpu = 0.0, 0.0, 0.0
+    t0, work, cpu, events = 0.0, 0.0, 0.0, 0
     ts, tu, es, tips = [], [], [], []
     e_load = None
     while t0 < t_end - 1e-12:
@@ -67,6 +67,7 @@ def long_run(n: int, t_end: float, segment: float, out: str | None, dt_out: floa
                        newton=NewtonOptions(**NEWTON),
                        monitors=[PointSensor(s=0.0, name="tip"), EnergyMonitor()])
         cpu += time.process_time() - c0
+        events += int(res.stats.get("model_events", 0))
         log = res.monitors["energy"]
         kin_str = np.asarray(log["kinetic"]) + np.asarray(log["strain"])
         E = kin_str - (work + np.asarray(log["work"]))
@@ -80,7 +81,7 @@ def long_run(n: int, t_end: float, segment: float, out: str | None, dt_out: floa
         dev = float(np.max(np.abs(e_arr[after] - e_load))) if e_load is not None else float("nan")
         print(f"BE3DSR {n} el: t = {t_arr[-1]:.3f} s, CPU {cpu:.0f} s ({cpu / t_arr[-1]:.2f} s per simulated s), "
               f"E = {e_arr[-1]:.9e} J, max |E - E(t_load)| after the load {dev:.2e} J, "
-              f"updates {res.stats['model_events']}, status {res.status}", flush=True)
+              f"director updates so far {events}, status {res.status}", flush=True)
         if out:
             np.savez(out, t=t_arr, kinetic_strain=np.asarray(tu), E=e_arr, tip=np.asarray(tips), cpu=cpu)
         if res.status != "success":
