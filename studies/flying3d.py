@@ -321,7 +321,7 @@ def run(be_meshes=None, sq_meshes=None, variants=None, variant_mesh=None, method
                                           variant_mesh=variant_mesh, methods=methods, long_run=long_run, t_end=t_end,
                                           t_end_sq=t_end_sq, h=h, dt_out=dt_out, em_run=em_run, be_steps=be_steps,
                                           update_below=update_below, sr_meshes=sr_meshes, eps_window=eps_window),
-                 zero_allowed=("long_run", "em_run"))
+                 zero_allowed=("long_run", "em_run", "be_steps", "update_below", "sr_meshes"))
     unknown = [m for m in o["methods"] if m not in METHODS]
     if unknown:
         raise OptionError(f"`methods` must be keys of {sorted(METHODS)}, got {unknown}.")

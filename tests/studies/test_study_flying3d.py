@@ -94,3 +94,13 @@ def test_quick_mode_writes_table_and_figures(quick):
 def test_chapter_failure_times_in_the_full_table():
     assert flying3d.CHAPTER_FAILURES == {8: 8.0, 16: 9.0, 32: 12.0}
     assert flying3d.FULL["be_meshes"] == (8, 16, 32) and flying3d.FULL["sq_meshes"] == (32, 64, 128)
+
+
+def test_options_documented_as_none_by_zero_accept_zero():
+    """``--sr-meshes 0``, ``--be-steps 0``, ``--update-below 0`` mean "none" (the CLI help says so).
+
+    Catches the option check rejecting the zero that the help offers (it did: "must be positive").
+    """
+    out = flying3d.run(quick=True, be_meshes=(2,), sq_meshes=(), em_run=(0, 0), sr_meshes=(0,), be_steps=(0,),
+                       update_below=(0,), t_end=0.02, plots=False, progress=False)
+    assert [(r["element"], r["n"]) for r in out["rows"]] == [("BE3D", 2)]

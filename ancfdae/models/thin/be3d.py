@@ -80,6 +80,10 @@ class BE3DReference(Kernel):
         """The rotary kinetic energy of :func:`.be3d_inertia.rotary_kinetic_energy`."""
         return rotary_kinetic_energy(geom["inertia"], geom, q, v, self.element.rhoJ)
 
+    def mass_bilinear(self, geom: dict, q: np.ndarray, u: np.ndarray, w: np.ndarray, order: int = 2) -> tuple:
+        """``1/2 u^T M_rot(q) w`` per element with its q-derivatives (:func:`.be3d_inertia.rotary_bilinear`)."""
+        return rotary_bilinear(geom["inertia"], geom, q, u, w, self.element.rhoJ, order)
+
 
 def _compiled(element: BE3D) -> Kernel:
     """The compiled kernel object; its module, and numba's loops with it, is imported when selected."""
@@ -313,8 +317,9 @@ class BE3D(Element):
         return self.kernels.kinetic_energy(geom, q, v)
 
     def mass_bilinear(self, geom: dict, q: np.ndarray, u: np.ndarray, w: np.ndarray, order: int = 2) -> tuple:
-        """``1/2 u^T M_rot(q) w`` per element, its q-gradient and Hessian (NumPy, :func:`.be3d_inertia.rotary_bilinear`)."""
-        return rotary_bilinear(geom["inertia"], geom, q, u, w, self.rhoJ, order)
+        """``1/2 u^T M_rot(q) w`` per element, its q-gradient and Hessian (the energy-momentum method's; by
+        ``order`` 0, 1, 2), from the selected kernel."""
+        return self.kernels.mass_bilinear(geom, q, u, w, order)
 
     # -- the director event (Sect. 3.6) -------------------------------------
     def event_state(self, geom: dict) -> dict:

@@ -12,7 +12,8 @@ and its derivatives with respect to the accelerations (``M``), velocities
 (``D``) and coordinates (``K``). Per point, ``g, G, Hg`` come from the jet of
 the scalar ``c = (a.d) / (|a| |d x a|^2)`` over ``a`` (three variables,
 :mod:`ancfdae.models.jets.scalar_numba`): ``g = c m``, ``m = d x a = [d]_x a``. Products with the
-Hermite operator ``Ba`` use its sparsity: ``(Ba^T x)[dof[k, i]] += dN_k x_i``.
+Hermite operator ``Ba`` use its sparsity: ``(Ba^T x)[dof[k, i]] += dN_k x_i``. The energy-momentum method's
+``1/2 u^T M_rot(q) w`` with its q-derivatives (:func:`be3d_mass_bilinear`) goes through :mod:`.rotary_numba`.
 """
 from __future__ import annotations
 
@@ -20,9 +21,10 @@ import numpy as np
 from numba import njit
 
 from ..jets import scalar_numba as jet
+from .rotary_numba import rotary_bilinear
 from .spatial_numba import slope
 
-__all__ = ["be3d_inertia", "be3d_inertia_element", "inertia_scratch", "be3d_kinetic_energy"]
+__all__ = ["be3d_inertia", "be3d_inertia_element", "inertia_scratch", "be3d_kinetic_energy", "be3d_mass_bilinear"]
 
 _P, _AD, _M2, _SP, _W, _R, _C = range(7)
 
@@ -242,3 +244,46 @@ def be3d_kinetic_energy(q, v, dof, theta, dN, wdx, lin, directors, rhoJ):
                 om += w[r] * v[e, r]
             T[e] += 0.5 * rhoJ * wdx[e, p] * om * om
     return T
+
+
+@njit(cache=True)
+def be3d_mass_bilinear(q, u, w, dof, theta, dN, wdx, lin, directors, rhoJ, order):
+    """``B = 1/2 u^T M_rot(q) w`` per element (n_el,), its q-gradient (n_el, 14) and, for ``order`` 2, Hessian
+    (n_el, 14, 14; else shape (0, 14, 14)): :func:`.be3d_inertia.rotary_bilinear`, compiled.
+
+    Per point the spin coefficients of :func:`.rotary_numba.rotary_bilinear`: ``c = N_theta + Ba^T g``,
+    ``C = Ba^T G Ba`` and ``Hc[i, k, l] = (Ba^T)_ij Hg[j, m, r] Ba_mk Ba_rl``, through the sparsity of ``Ba``.
+    """
+    n_el, n = q.shape
+    B = np.zeros(n_el)
+    g_out = np.zeros((n_el, n))
+    Hq = np.zeros((n_el if order >= 2 else 1, n, n))
+    a, d, g = np.empty(3), np.empty(3), np.empty(3)
+    Gm, Hg = np.empty((3, 3)), np.zeros((3, 3, 3))
+    c, C = np.empty(n), np.zeros((n, n))
+    Hc = np.zeros((n if order >= 2 else 1, n, n))
+    work = np.empty((2, n))
+    scratch = spin_scratch(2 if order >= 2 else 1)
+    for e in range(n_el):
+        j = e if order >= 2 else 0
+        for p in range(wdx.shape[1]):
+            dNp = dN[e, p]
+            _point_state(q[e], dof, theta, dNp, lin[p, 0], lin[p, 1], directors[e], directors[e + 1],
+                         a, d, c, g, Gm, Hg, 2 if order >= 2 else 1, scratch)
+            if order >= 1:
+                C[:] = 0.0
+                _bat_m_ba(C, dof, dNp, Gm, 1.0)
+            if order >= 2:
+                Hc[:] = 0.0
+                for k1 in range(4):
+                    for k2 in range(4):
+                        for k3 in range(4):
+                            s = dNp[k1] * dNp[k2] * dNp[k3]
+                            for i1 in range(3):
+                                for i2 in range(3):
+                                    for i3 in range(3):
+                                        Hc[dof[k1, i1], dof[k2, i2], dof[k3, i3]] += s * Hg[i1, i2, i3]
+            B[e] += rotary_bilinear(rhoJ * wdx[e, p], c, C, Hc, u[e], w[e], g_out[e], Hq[j], order, work)
+    if order < 2:
+        return B, g_out, Hq[:0]
+    return B, g_out, Hq

@@ -24,7 +24,7 @@ from numba import njit
 
 from ..element import OnePassKernel
 from ..jets import scalar_numba as jet
-from .be3d_inertia_numba import be3d_inertia, be3d_kinetic_energy
+from .be3d_inertia_numba import be3d_inertia, be3d_kinetic_energy, be3d_mass_bilinear
 from .be3d_moment_numba import be3d_moment
 from .spatial_numba import axial_point, hermite_map, scatter, slope
 
@@ -259,6 +259,14 @@ class BE3DCompiled(OnePassKernel):
         return be3d_kinetic_energy(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(v, dtype=float),
                                    rule.dof_map, rule.theta, rule.dN, rule.wdx, rule.lin, _directors(geom),
                                    self.element.rhoJ)
+
+    def mass_bilinear(self, geom: dict, q: np.ndarray, u: np.ndarray, w: np.ndarray, order: int = 2) -> tuple:
+        """As :meth:`.be3d.BE3DReference.mass_bilinear`, compiled (:func:`.be3d_inertia_numba.be3d_mass_bilinear`)."""
+        rule = geom["inertia"]
+        out = be3d_mass_bilinear(*(np.ascontiguousarray(x, dtype=float) for x in (q, u, w)), rule.dof_map,
+                                 rule.theta, rule.dN, rule.wdx, rule.lin, _directors(geom), self.element.rhoJ,
+                                 int(order))
+        return out[:order + 1]
 
 
 def _directors(geom):

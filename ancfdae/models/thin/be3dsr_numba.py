@@ -3,7 +3,8 @@
 The compiled twin of :class:`.be3dsr.BE3DSRReference`: per quadrature point the same vector-jet operations
 as :mod:`.be3dsr_kinematics`, in the same order, on rows of work arrays
 (:mod:`ancfdae.models.jets.vector_numba`), over the 14 element coordinates. The rotary inertia goes through
-:mod:`.rotary_numba` from the spin coefficients ``(c, C, Hc)``. Work arrays are allocated once per call.
+:mod:`.rotary_numba` from the spin coefficients ``(c, C, Hc)``. Work arrays are allocated once per call;
+the nodal frames, which do not depend on the point, are computed once per element (:func:`_nodes`).
 
 numba's cache is keyed on this file only: after editing :mod:`ancfdae.models.jets.vector_numba` or
 :mod:`.rotary_numba`, delete the ``*.nbi``/``*.nbc`` files in ``__pycache__`` (see
@@ -107,24 +108,33 @@ def _transport(V, G, H, X, order):
 
 
 @njit(cache=True, inline="always")
-def _common(V, G, H, q, dof, dN, dA, dB, one, order):
-    """Slope, tangent, nodal frames and transports at a point (:func:`.be3dsr_kinematics._common`)."""
-    _hermite(V, G, H, A, q, dof, dN, order)
+def _nodes(V, G, H, q, dA, dB, one, order):
+    """The two nodal frames and the constant row ONE: once per element, since they do not depend on the
+    point (the point operations below write none of the node rows they read: XA, XD, XU, XINV, XM, XM2,
+    XE2, XE3)."""
     vj.constant(V, G, H, ONE, one, 1, order)
+    _node(V, G, H, N0, q, 3, dA, order)
+    _node(V, G, H, N0 + NODE, q, 10, dB, order)
+
+
+@njit(cache=True, inline="always")
+def _common(V, G, H, q, dof, dN, order):
+    """Slope, tangent and the transports of the nodal frames at a point, after :func:`_nodes`
+    (:func:`.be3dsr_kinematics._common`)."""
+    _hermite(V, G, H, A, q, dof, dN, order)
     vj.dot(V, G, H, PA, A, A, 3, order)
     vj.sqrt(V, G, H, NA, PA, order)
     vj.recip(V, G, H, INA, NA, order)
     vj.mul(V, G, H, T, INA, A, 1.0, 3, order)
-    _node(V, G, H, N0, q, 3, dA, order)
     _transport(V, G, H, N0, order)
-    _node(V, G, H, N0 + NODE, q, 10, dB, order)
     _transport(V, G, H, N0 + NODE, order)
 
 
 @njit(cache=True, inline="always")
-def _curvatures(V, G, H, q, dof, dN, ddN, dA, dB, S5, S6, L, one, order):
-    """Rows K1, K2, K3 := twist and curvatures at a point (:func:`.be3dsr_kinematics.curvatures`)."""
-    _common(V, G, H, q, dof, dN, dA, dB, one, order)
+def _curvatures(V, G, H, q, dof, dN, ddN, S5, S6, L, order):
+    """Rows K1, K2, K3 := twist and curvatures at a point, after :func:`_nodes`
+    (:func:`.be3dsr_kinematics.curvatures`)."""
+    _common(V, G, H, q, dof, dN, order)
     XA_, XB_ = N0, N0 + NODE
     _hermite(V, G, H, B, q, dof, ddN, order)
     vj.dot(V, G, H, SN, XA_ + XEB3, XB_ + XEB2, 3, order)
@@ -180,9 +190,9 @@ def sr_forces(q, dof, dNa, wa, slope_ref, dNb, ddNb, wb, lin, L, directors, k_re
         for p in range(wa.shape[1]):
             U[e] += axial_point(f[e], Ke, q[e], dof, dNa[e, p], wa[e, p], slope_ref[e, p], EA, a, idx, coef, grad,
                                 Hl, order >= 2)
+        _nodes(V, G, H, q[e], directors[e], directors[e + 1], one, order)
         for p in range(wb.shape[1]):
-            _curvatures(V, G, H, q[e], dof, dNb[e, p], ddNb[e, p], directors[e], directors[e + 1], lin[p, 0],
-                        lin[p, 1], L[e], one, order)
+            _curvatures(V, G, H, q[e], dof, dNb[e, p], ddNb[e, p], lin[p, 0], lin[p, 1], L[e], order)
             for i in range(3):
                 wc = stiffness[i] * wb[e, p]
                 r = V[K1 + i, 0] - k_ref[e, p, i]
@@ -199,12 +209,13 @@ def sr_forces(q, dof, dNa, wa, slope_ref, dNb, ddNb, wb, lin, L, directors, k_re
 
 
 @njit(cache=True, inline="always")
-def sr_spin(V, G, H, q, dof, dN, dA, dB, S5, S6, one, c, C, Hc, order):
-    """The spin coefficients ``c`` (14,), ``C`` (14, 14), ``Hc`` (14, 14, 14) at a point (by ``order``).
+def sr_spin(V, G, H, q, dof, dN, S5, S6, c, C, Hc, order):
+    """The spin coefficients ``c`` (14,), ``C`` (14, 14), ``Hc`` (14, 14, 14) at a point (by ``order``), after
+    :func:`_nodes` for the element.
 
     :func:`.be3dsr_kinematics.spin_coefficients`: per node ``c_X = g_X + h_X/|a_X|`` and ``ch_X = h_X/|a|``.
     """
-    _common(V, G, H, q, dof, dN, dA, dB, one, order)
+    _common(V, G, H, q, dof, dN, order)
     for X in (N0, N0 + NODE):
         vj.dot(V, G, H, X + SAD, X + XA, X + XD, 3, order)
         vj.recip(V, G, H, X + SW, X + XINV, order)
@@ -275,9 +286,9 @@ def sr_rotary(q, v, acc, dof, dN, wdx, lin, directors, rhoJ, mode, order):
     spin_order = order if mode != 0 else 0
     for e in range(n_el):
         j = e if order >= 2 else 0
+        _nodes(V, G, H, q[e], directors[e], directors[e + 1], one, spin_order)
         for p in range(wdx.shape[1]):
-            sr_spin(V, G, H, q[e], dof, dN[e, p], directors[e], directors[e + 1], lin[p, 0], lin[p, 1], one,
-                    c, C, Hc, spin_order)
+            sr_spin(V, G, H, q[e], dof, dN[e, p], lin[p, 0], lin[p, 1], c, C, Hc, spin_order)
             W = rhoJ * wdx[e, p]
             if mode == 0:
                 s_out[e] += rotary_energy(W, c, v[e])

@@ -37,6 +37,26 @@ def test_compiled_kernels_equal_the_numpy_reference():
     assert rel_err(comp.kinetic_energy_extra(g, q, v), ref.kinetic_energy_extra(g, q, v)) < 1e-13
 
 
+def test_compiled_mass_bilinear_equals_the_numpy_reference():
+    """The energy-momentum method's ``1/2 u^T M_rot(q) w`` with dB/dq and d2B/dq2 on a bent, twisted state, at
+    every ``order`` (the compiled spin runs a lower-order branch below 2).
+
+    Catches the compiled form drifting from the reference (a wrong spin coefficient row, a lost Hessian term, a
+    lower-order branch that differs); a formula error shared by both passes here, the beam-level finite
+    differences of these forms hold that (tests/integrators/test_energy_momentum_variable_mass.py).
+    """
+    sec = RectangularSection(0.05, 0.03)
+    ref, comp = BE3DSR(B3_MAT, sec, kernel="numpy"), BE3DSR(B3_MAT, sec, kernel="numba")
+    beam, q, v, a = _state(ref, seed=11)
+    g = beam.geom
+    full = comp.mass_bilinear(g, q, v, a, 2)
+    for order in (0, 1, 2):
+        got, want = comp.mass_bilinear(g, q, v, a, order), ref.mass_bilinear(g, q, v, a, order)
+        assert len(got) == len(want) == order + 1
+        for x, y, z in zip(got, want, full):
+            assert rel_err(x, y) < 1e-13 and np.array_equal(x, z)
+
+
 def test_forces_tangent_and_inertia_against_finite_differences():
     """Catches: a force that is not dU/dq, a tangent or inertia block that is not the derivative."""
     el = BE3DSR(B3_MAT, FLAT, kernel="numpy")

@@ -182,3 +182,26 @@ def test_compiled_be3d_moment_load_equals_reference_and_finite_differences():
     qe = next(_states(beam, seed=9))[0][1] + 0.05
     _, K = el.moment_load(g, qe, 0.37, M, 1, True)
     assert rel_err(K, fd_gradient(lambda x: el.moment_load(g, x, 0.37, M, 1, False)[0], qe, h=1e-6)) < 1e-6
+
+
+def test_compiled_be3d_mass_bilinear_equals_reference_block_by_block():
+    """The energy-momentum method's ``B = 1/2 u^T M_rot(q) w``, dB/dq and d2B/dq2: compiled == reference, each
+    to 1e-12 of itself, at every ``order`` (0, 1, 2 run different branches); ``B(q, v, v)`` is the kinetic energy.
+
+    Catches an index slip in the compiled ``C = Ba^T G Ba`` or ``Hc`` (e.g. the director or the torsion rows
+    swapped), a missing point or element, or a lower-order branch that differs. A formula error shared by both
+    would pass here; the finite-difference test of the beam's forms (tests/integrators) holds that.
+    """
+    el, beam = _beam("BE3D")
+    g = beam.geom
+    pairs = []
+    for qe, ue, we in _states(beam, seed=6):
+        pairs.append(_both(el, lambda: el.mass_bilinear(g, qe, ue, we, 2)))
+        for order in (0, 1):
+            lower = _both(el, lambda: el.mass_bilinear(g, qe, ue, we, order))
+            assert len(lower[0]) == len(lower[1]) == order + 1
+            for got, ref in zip(lower[0], pairs[-1][0]):
+                assert np.array_equal(got, ref)
+        T = el.kinetic_energy_extra(g, qe, ue)
+        assert rel_err(el.mass_bilinear(g, qe, ue, ue, 0)[0], T) < 1e-13
+    _assert_equal_by_block(pairs, ["B", "dB/dq", "d2B/dq2"])
