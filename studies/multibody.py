@@ -2,13 +2,17 @@
 
 B5 spin-up of a flexible beam (Simo & Vu-Quoc 1986), B6 flexible slider-crank and B7 flexible spatial pendulum
 with a spinning rigid payload (:mod:`ancfdae.studies._multibody_models`), each run by every registered
-integrator that declares ``handles_constraints`` at a sequence of steps, and once by generalized-alpha at a
-step ``refine`` times finer: the reference of the same model. Per run: the error of every output of the
-benchmark against the reference (largest over the outputs, relative to the reference's largest value), the
-position drift ``max |g|`` and the velocity drift ``max |G v + g_t|`` over the outputs, on B7 the energy error
-``max |E - E0|`` relative to the largest kinetic energy and the drift of the angular momentum about the
-vertical, the CPU time; per integrator the observed orders of the outputs (least-squares slopes of log error
-against log step).
+integrator that declares ``handles_constraints`` at a sequence of steps. The reference of each model is
+Lobatto IIIA-3 (order 4 in the positions) at a step ``refine`` times finer than the finest, checked against
+a second Lobatto IIIA-3 run at twice its step: their difference bounds the reference's own error (the
+table gives it), and a run whose error is within :data:`FLOOR` times that bound does not enter an order
+(a reference of a second-order method, as generalized-alpha at h/2 was, is as coarse as the runs of the
+fourth-order methods, whose orders then meant nothing). Per run: the errors of the position outputs and of
+the multiplier outputs (hub torque, slider normal force, crank torque, pivot force; each output relative
+to the reference's largest value, the largest over the kind), the position drift ``max |g|`` and the
+velocity drift ``max |G v + g_t|`` over the outputs, on B7 the energy error ``max |E - E0|`` relative to
+the largest kinetic energy and the drift of the angular momentum about the vertical, the CPU time; per
+integrator the observed orders of ``q`` and ``lambda`` (least-squares slopes of log error against log step).
 
 Run: ``ancfdae study multibody [--quick] [--out DIR] [--jobs N]``.
 """
@@ -31,6 +35,13 @@ __all__ = ["run", "run_case", "FULL", "QUICK", "CLI_OPTIONS", "constrained_metho
 
 #: benchmark -> (element, elements, builder options)
 MODELS = {"B5": ("BE2D", 8, {"w_s": 4.0}), "B6": ("BE2D", 8, {}), "B7": ("Cable3D", 4, {"E": 5.0e7})}
+#: the outputs that are multipliers (reactions); the others but the invariants are positions
+MULTIPLIER_OUTPUTS = ("hub_torque", "slider_normal_force", "crank_torque", "pivot_force_z")
+INVARIANTS = ("energy", "angular_momentum_z")
+#: the reference method (and its check at twice the step)
+REFERENCE = "lobatto3"
+#: a run whose error is below FLOOR times the reference's error bound does not enter an order
+FLOOR = 10.0
 #: options per method (beyond h)
 OPTIONS = {"hht": {"alpha": 0.05}, "generalized-alpha": {"rho_inf": 0.8}}
 
@@ -95,13 +106,27 @@ def outputs(record: dict) -> dict:
     return rec
 
 
-def _error(rec, ref) -> float:
-    """Largest output error against the reference, each relative to the reference's largest value."""
-    if rec["t"].size != ref["t"].size:
-        return float("nan")
-    errs = [np.abs(rec["out"][k] - ref["out"][k]).max() / max(np.abs(ref["out"][k]).max(), 1e-300)
-            for k in ref["out"] if k not in ("energy", "angular_momentum_z")]
-    return float(max(errs))
+def _errors(rec, ref) -> dict:
+    """``{"q": ..., "lam": ...}``: the largest error of the position and of the multiplier outputs against
+    the reference, each output relative to the reference's largest value (NaN when a run stopped early)."""
+    out = {}
+    for kind in ("q", "lam"):
+        keys = [k for k in ref["out"] if k not in INVARIANTS and (k in MULTIPLIER_OUTPUTS) == (kind == "lam")]
+        if rec["t"].size != ref["t"].size or not keys:
+            out[kind] = float("nan")
+            continue
+        out[kind] = float(max(np.abs(rec["out"][k] - ref["out"][k]).max() / max(np.abs(ref["out"][k]).max(), 1e-300)
+                              for k in keys))
+    return out
+
+
+def _order(points, floor) -> float | None:
+    """Least-squares slope of log error against log step over the points above ``FLOOR * floor``."""
+    pts = [(h, e) for h, e in points if np.isfinite(e) and e > FLOOR * floor]
+    if len(pts) < 2:
+        return None
+    h, e = np.log(np.array(pts)).T
+    return float(np.polyfit(h, e, 1)[0])
 
 
 def run(benchmarks=None, integrators=None, steps=None, rtols=None, t_end=None, refine=None, n_out=None,
@@ -122,7 +147,7 @@ def run(benchmarks=None, integrators=None, steps=None, rtols=None, t_end=None, r
         about 10 times generalized-alpha's CPU per decade of rtol on B6: 6 s at 1e-4, 72 s at 1e-5 for the
         quick 0.05 s; hence 1e-3 and 1e-4).
     refine : int
-        The reference runs generalized-alpha at the finest step divided by ``refine``.
+        The reference runs :data:`REFERENCE` at the finest step divided by ``refine`` (its check at twice that).
     n_out : int
         Output times (equally spaced, both ends included).
     quick, out, jobs, executor, plots, progress
@@ -131,8 +156,9 @@ def run(benchmarks=None, integrators=None, steps=None, rtols=None, t_end=None, r
     Returns
     -------
     dict
-        ``rows`` (one per run: error, drifts, invariants, CPU), ``orders`` (per benchmark and integrator) and
-        the keys of every study.
+        ``rows`` (one per run: errors of q and lambda, drifts, invariants, CPU), ``orders`` and
+        ``orders_lam`` (per benchmark and integrator, q and lambda), ``reference_errors`` (per benchmark and
+        kind: the reference's difference from its check) and the keys of every study.
     """
     o = settings(FULL, QUICK, quick, dict(benchmarks=benchmarks, integrators=integrators, steps=steps,
                                           rtols=rtols, t_end=t_end, refine=refine, n_out=n_out))
@@ -146,8 +172,9 @@ def run(benchmarks=None, integrators=None, steps=None, rtols=None, t_end=None, r
     for bm in o["benchmarks"]:
         base = {"benchmark": bm, "t_end": o["t_end"][bm], "n_out": o["n_out"]}
         h_ref = min(o["steps"][bm]) / o["refine"]
-        cases.append(Case(dict(base, integrator="generalized-alpha", h=h_ref, reference=True),
-                          label=f"{bm} reference h={h_ref:g}", cost=base["t_end"] / h_ref))
+        cases += [Case(dict(base, integrator=REFERENCE, h=k * h_ref, reference=role),
+                       label=f"{bm} reference ({role}) h={k * h_ref:g}", cost=4 * base["t_end"] / (k * h_ref))
+                  for k, role in ((1, "main"), (2, "check"))]
         for m in methods:
             xs, name = (o["steps"][bm], "h") if _fixed_step(m) else (o["rtols"], "rtol")
             cases += [Case(dict(base, integrator=m, h=x, reference=False), label=f"{bm} {m} {name}={x:g}",
@@ -155,38 +182,49 @@ def run(benchmarks=None, integrators=None, steps=None, rtols=None, t_end=None, r
     sweep = run_cases(run_case, cases, out=path, executor=executor, jobs=jobs, reduce=outputs, name="multibody",
                       progress=progress, cost=lambda c: c["cost"])
     records = sweep.finished()
-    refs = {r["benchmark"]: r for r in records if r["reference"]}
+    refs = {r["benchmark"]: r for r in records if r["reference"] == "main"}
+    checks = {r["benchmark"]: r for r in records if r["reference"] == "check"}
+    # the reference's error bound per kind: its difference from the check (NaN without the check)
+    floors = {bm: _errors(checks[bm], ref) if bm in checks else {"q": float("nan"), "lam": float("nan")}
+              for bm, ref in refs.items()}
     rows = []
     for r in records:
         if r["reference"] or r["benchmark"] not in refs:
             continue
+        e = _errors(r, refs[r["benchmark"]])
         rows.append({k: r.get(k) for k in ("benchmark", "integrator", "h", "status", "cpu", "drift_q", "drift_v",
-                                            "energy_error", "momentum_error")} | {"error": _error(r, refs[r["benchmark"]])})
-    orders = {}
-    for bm in o["benchmarks"]:
+                                            "energy_error", "momentum_error")} | {"error": e["q"], "error_lam": e["lam"]})
+    orders, orders_lam = {}, {}
+    for bm in refs:
         for m in methods:
-            pts = [(r["h"], r["error"]) for r in rows if r["benchmark"] == bm and r["integrator"] == m
-                   and np.isfinite(r["error"]) and r["error"] > 0]
-            if len(pts) >= 2:
-                h, e = np.log(np.array(pts)).T
-                orders[(bm, m)] = float(np.polyfit(h, e, 1)[0])
-    table = _table(rows, orders, refs, sweep.errors)
+            mine = [r for r in rows if r["benchmark"] == bm and r["integrator"] == m]
+            for key, kind, dest in (("error", "q", orders), ("error_lam", "lam", orders_lam)):
+                p = _order([(r["h"], r[key]) for r in mine], np.nan_to_num(floors[bm][kind], nan=0.0))
+                if p is not None:
+                    dest[(bm, m)] = p
+    table = _table(rows, orders, orders_lam, refs, floors, sweep.errors)
     if plots:
         (path / "multibody.md").write_text("# Flexible multibody benchmarks B5-B7\n\n" + table)
-    return {"rows": rows, "orders": orders, "references": refs, "records": records, "errors": sweep.errors,
+    return {"rows": rows, "orders": orders, "orders_lam": orders_lam, "references": refs,
+            "reference_errors": floors, "records": records, "errors": sweep.errors,
             "reused": sweep.reused, "figures": {}, "table": table, "path": path}
 
 
-def _table(rows, orders, refs, errors) -> str:
-    headers = ["benchmark", "integrator", "h (s) or rtol", "status", "error vs reference", "order", "max |g|",
-               "max |G v + g_t|", "energy error (B7)", "L_z drift (B7)", "CPU (s)"]
+def _table(rows, orders, orders_lam, refs, floors, errors) -> str:
+    headers = ["benchmark", "integrator", "h (s) or rtol", "status", "error q", "order q", "error lambda",
+               "order lambda", "max |g|", "max |G v + g_t|", "energy error (B7)", "L_z drift (B7)", "CPU (s)"]
     body = [[r["benchmark"], r["integrator"], f"{r['h']:g}", r["status"], cell(r["error"], ".2e"),
-             cell(orders.get((r["benchmark"], r["integrator"])), ".2f"), cell(r["drift_q"], ".1e"),
+             cell(orders.get((r["benchmark"], r["integrator"])), ".2f"), cell(r["error_lam"], ".2e"),
+             cell(orders_lam.get((r["benchmark"], r["integrator"])), ".2f"), cell(r["drift_q"], ".1e"),
              cell(r["drift_v"], ".1e"), cell(r["energy_error"], ".1e"), cell(r["momentum_error"], ".1e"),
              f"{r['cpu']:.1f}"] for r in rows]
-    text = "References: generalized-alpha (rho_inf 0.8) at " + ", ".join(
-        f"{bm} h = {r['h']:g} s" for bm, r in refs.items()) + ". Errors: largest over the outputs, each relative " \
-        "to the reference's largest value; order: slope of log error against log h (IDA: against log rtol).\n\n"
+    text = f"References: {REFERENCE} at " + ", ".join(
+        f"{bm} h = {r['h']:g} s (differs from the run at 2h by {cell(floors[bm]['q'], '.1e')} in q, "
+        f"{cell(floors[bm]['lam'], '.1e')} in lambda)" for bm, r in refs.items()) + \
+        ". Errors: largest over the position (q) or multiplier (lambda: hub torque, slider normal force, crank " \
+        "torque, pivot force) outputs, each relative to the reference's largest value; order: slope of log " \
+        f"error against log h (IDA: against log rtol) over the runs whose error exceeds {FLOOR:g} times the " \
+        "reference's difference from its check.\n\n"
     return text + markdown_table(headers, body) + errors_note(errors)
 
 
