@@ -3,8 +3,9 @@
 B5 spin-up of a flexible beam (Simo & Vu-Quoc 1986), B6 flexible slider-crank and B7 flexible spatial pendulum
 with a spinning rigid payload (:mod:`ancfdae.studies._multibody_models`), each run by every registered
 integrator that declares ``handles_constraints`` at a sequence of steps. The reference of each model is
-Lobatto IIIA-3 (order 4 in the positions) at a step ``refine`` times finer than the finest, checked against
-a second Lobatto IIIA-3 run at twice its step: their difference bounds the reference's own error (the
+Lobatto IIIA-3 (order 4 in the positions) at a step ``refine`` times finer than the finest (B5, where it
+fails: generalized-alpha 8 times finer; :data:`REFERENCE`), checked against a second run of the same
+method at twice its step: their difference bounds the reference's own error (the
 table gives it), and a run whose error is within :data:`FLOOR` times that bound does not enter an order
 (a reference of a second-order method, as generalized-alpha at h/2 was, is as coarse as the runs of the
 fourth-order methods, whose orders then meant nothing). Per run: the errors of the position outputs and of
@@ -31,15 +32,18 @@ from ._common import Case, OptionError, output_dir, run_cases, settings
 from ._multibody_models import BUILDERS
 from ._tables import cell, errors_note, markdown_table
 
-__all__ = ["run", "run_case", "FULL", "QUICK", "CLI_OPTIONS", "constrained_methods"]
+__all__ = ["run", "run_case", "summarize", "FULL", "QUICK", "CLI_OPTIONS", "constrained_methods"]
 
 #: benchmark -> (element, elements, builder options)
 MODELS = {"B5": ("BE2D", 8, {"w_s": 4.0}), "B6": ("BE2D", 8, {}), "B7": ("Cable3D", 4, {"E": 5.0e7})}
 #: the outputs that are multipliers (reactions); the others but the invariants are positions
 MULTIPLIER_OUTPUTS = ("hub_torque", "slider_normal_force", "crank_torque", "pivot_force_z")
 INVARIANTS = ("energy", "angular_momentum_z")
-#: the reference method (and its check at twice the step)
-REFERENCE = "lobatto3"
+#: the reference method per benchmark and how much finer than the finest step it runs (its check: at twice
+#: its step). Lobatto IIIA-3 where it runs the whole span; on the 30-s B5 every method without numerical
+#: dissipation fails (Lobatto IIIA-3 at h = 0.0125 at 9.7 s, Lobatto IIIA-2 and Newmark at 9.6-12.6 s:
+#: Newton diverges), so B5's reference is generalized-alpha 8 times finer than the finest step.
+REFERENCE = {"B5": ("generalized-alpha", 8), "B6": ("lobatto3", 2), "B7": ("lobatto3", 2)}
 #: a run whose error is below FLOOR times the reference's error bound does not enter an order
 FLOOR = 10.0
 #: options per method (beyond h)
@@ -47,9 +51,9 @@ OPTIONS = {"hht": {"alpha": 0.05}, "generalized-alpha": {"rho_inf": 0.8}}
 
 FULL = dict(benchmarks=tuple(MODELS), integrators=None, steps={"B5": (0.1, 0.05, 0.025), "B6": (8e-4, 4e-4, 2e-4),
             "B7": (0.02, 0.01, 0.005)}, rtols=(1e-3, 1e-4), t_end={"B5": 30.0, "B6": 0.5, "B7": 5.0},
-            refine=2, n_out=51)
+            refine=None, n_out=51)
 QUICK = dict(steps={"B5": (0.1, 0.05), "B6": (4e-4, 2e-4), "B7": (0.02, 0.01)}, rtols=(1e-3, 1e-4),
-             t_end={"B5": 4.0, "B6": 0.06, "B7": 0.2}, refine=2, n_out=11)
+             t_end={"B5": 4.0, "B6": 0.06, "B7": 0.2}, refine=None, n_out=11)
 CLI_OPTIONS = [
     Option("benchmarks", str, "benchmarks", nargs="+", choices=tuple(MODELS)),
     Option("integrators", str, "integrators (default: every method that handles constraints)", nargs="+"),
@@ -134,6 +138,34 @@ def _order(points, floor) -> float | None:
     return float(np.polyfit(h, e, 1)[0])
 
 
+def summarize(records: list[dict], methods) -> tuple:
+    """Rows, orders of q and lambda, references and the references' error bounds of finished records
+    (those :func:`outputs` made; also from the stored cases of an interrupted run)."""
+    refs = {r["benchmark"]: r for r in records if r["reference"] == "main"}
+    checks = {r["benchmark"]: r for r in records if r["reference"] == "check" or (
+        not r["reference"] and r["benchmark"] in refs and r["integrator"] == refs[r["benchmark"]]["integrator"]
+        and np.isclose(r["h"], 2 * refs[r["benchmark"]]["h"], rtol=1e-9))}
+    # the reference's error bound per kind: its difference from the check (NaN without the check)
+    floors = {bm: _errors(checks[bm], ref) if bm in checks else {"q": float("nan"), "lam": float("nan")}
+              for bm, ref in refs.items()}
+    rows = []
+    for r in records:
+        if r["reference"] or r["benchmark"] not in refs:
+            continue
+        e = _errors(r, refs[r["benchmark"]])
+        rows.append({k: r.get(k) for k in ("benchmark", "integrator", "h", "status", "cpu", "drift_q", "drift_v",
+                                            "energy_error", "momentum_error")} | {"error": e["q"], "error_lam": e["lam"]})
+    orders, orders_lam = {}, {}
+    for bm in refs:
+        for m in methods:
+            mine = [r for r in rows if r["benchmark"] == bm and r["integrator"] == m]
+            for key, kind, dest in (("error", "q", orders), ("error_lam", "lam", orders_lam)):
+                p = _order([(r["h"], r[key]) for r in mine], np.nan_to_num(floors[bm][kind], nan=0.0))
+                if p is not None:
+                    dest[(bm, m)] = p
+    return rows, orders, orders_lam, refs, floors
+
+
 def run(benchmarks=None, integrators=None, steps=None, rtols=None, t_end=None, refine=None, n_out=None,
         quick: bool = False, out=None, jobs: int | None = None, executor=None, plots: bool = True,
         progress: bool = True) -> dict:
@@ -151,8 +183,9 @@ def run(benchmarks=None, integrators=None, steps=None, rtols=None, t_end=None, r
         The relative tolerances of the variable-step methods (IDA), in place of the steps (IDA costs
         about 10 times generalized-alpha's CPU per decade of rtol on B6: 6 s at 1e-4, 72 s at 1e-5 for the
         quick 0.05 s; hence 1e-3 and 1e-4).
-    refine : int
-        The reference runs :data:`REFERENCE` at the finest step divided by ``refine`` (its check at twice that).
+    refine : int, optional
+        The reference runs its method (:data:`REFERENCE`) at the finest step divided by ``refine`` (its check
+        at twice that); default: the benchmark's own in :data:`REFERENCE`.
     n_out : int
         Output times (equally spaced, both ends included).
     quick, out, jobs, executor, plots, progress
@@ -176,10 +209,11 @@ def run(benchmarks=None, integrators=None, steps=None, rtols=None, t_end=None, r
     cases = []
     for bm in o["benchmarks"]:
         base = {"benchmark": bm, "t_end": o["t_end"][bm], "n_out": o["n_out"]}
-        h_ref = min(o["steps"][bm]) / o["refine"]
+        method, refine_bm = REFERENCE[bm]
+        h_ref = min(o["steps"][bm]) / (o["refine"] or refine_bm)
         # the check is the reference method's own run at 2 h_ref when the sweep has it (refine = 2)
-        roles = [(1, "main")] + ([] if _runs_at(REFERENCE, 2 * h_ref, methods, o["steps"][bm]) else [(2, "check")])
-        cases += [Case(dict(base, integrator=REFERENCE, h=k * h_ref, reference=role),
+        roles = [(1, "main")] + ([] if _runs_at(method, 2 * h_ref, methods, o["steps"][bm]) else [(2, "check")])
+        cases += [Case(dict(base, integrator=method, h=k * h_ref, reference=role),
                        label=f"{bm} reference ({role}) h={k * h_ref:g}", cost=4 * base["t_end"] / (k * h_ref))
                   for k, role in roles]
         for m in methods:
@@ -189,28 +223,7 @@ def run(benchmarks=None, integrators=None, steps=None, rtols=None, t_end=None, r
     sweep = run_cases(run_case, cases, out=path, executor=executor, jobs=jobs, reduce=outputs, name="multibody",
                       progress=progress, cost=lambda c: c["cost"])
     records = sweep.finished()
-    refs = {r["benchmark"]: r for r in records if r["reference"] == "main"}
-    checks = {r["benchmark"]: r for r in records if r["reference"] == "check" or (
-        not r["reference"] and r["integrator"] == REFERENCE and r["benchmark"] in refs
-        and np.isclose(r["h"], 2 * refs[r["benchmark"]]["h"], rtol=1e-9))}
-    # the reference's error bound per kind: its difference from the check (NaN without the check)
-    floors = {bm: _errors(checks[bm], ref) if bm in checks else {"q": float("nan"), "lam": float("nan")}
-              for bm, ref in refs.items()}
-    rows = []
-    for r in records:
-        if r["reference"] or r["benchmark"] not in refs:
-            continue
-        e = _errors(r, refs[r["benchmark"]])
-        rows.append({k: r.get(k) for k in ("benchmark", "integrator", "h", "status", "cpu", "drift_q", "drift_v",
-                                            "energy_error", "momentum_error")} | {"error": e["q"], "error_lam": e["lam"]})
-    orders, orders_lam = {}, {}
-    for bm in refs:
-        for m in methods:
-            mine = [r for r in rows if r["benchmark"] == bm and r["integrator"] == m]
-            for key, kind, dest in (("error", "q", orders), ("error_lam", "lam", orders_lam)):
-                p = _order([(r["h"], r[key]) for r in mine], np.nan_to_num(floors[bm][kind], nan=0.0))
-                if p is not None:
-                    dest[(bm, m)] = p
+    rows, orders, orders_lam, refs, floors = summarize(records, methods)
     table = _table(rows, orders, orders_lam, refs, floors, sweep.errors) + _linear_b5(refs)
     if plots:
         (path / "multibody.md").write_text("# Flexible multibody benchmarks B5-B7\n\n" + table)
@@ -240,8 +253,8 @@ def _table(rows, orders, orders_lam, refs, floors, errors) -> str:
              cell(orders_lam.get((r["benchmark"], r["integrator"])), ".2f"), cell(r["drift_q"], ".1e"),
              cell(r["drift_v"], ".1e"), cell(r["energy_error"], ".1e"), cell(r["momentum_error"], ".1e"),
              f"{r['cpu']:.1f}"] for r in rows]
-    text = f"References: {REFERENCE} at " + ", ".join(
-        f"{bm} h = {r['h']:g} s (differs from the run at 2h by {cell(floors[bm]['q'], '.1e')} in q, "
+    text = "References: " + ", ".join(
+        f"{bm} {r['integrator']} at h = {r['h']:g} s (differs from the run at 2h by {cell(floors[bm]['q'], '.1e')} in q, "
         f"{cell(floors[bm]['lam'], '.1e')} in lambda)" for bm, r in refs.items()) + \
         ". Errors: largest over the position (q) or multiplier (lambda: hub torque, slider normal force, crank " \
         "torque, pivot force) outputs, each relative to the reference's largest value; order: slope of log " \
