@@ -125,9 +125,21 @@ def bodies_of(result: Result, beam: Beam | RigidBody | None = None) -> list[tupl
     return [(beam_of(result), slice(None))]
 
 
-def joints_of(result: Result, beam=None) -> list[dict]:
-    """The joint records of a System's result (:func:`ancfdae.joint_points.describe_joints`): from ``beam``
-    when it is the System, else from ``result.model``; empty without joints."""
+def joints_of(result: Result, beam: Beam | RigidBody | None = None) -> list[dict]:
+    """The joint records of a System's result (:func:`ancfdae.joint_points.describe_joints`).
+
+    Parameters
+    ----------
+    result : Result
+        A run's result; its ``model`` description holds a System's joints.
+    beam : System, Beam or RigidBody, optional
+        When it is the System of the run, its joints are described directly.
+
+    Returns
+    -------
+    list of dict
+        One record per joint; empty without joints.
+    """
     if beam is not None and hasattr(beam, "joints") and hasattr(beam, "bodies"):
         return describe_joints(beam.bodies, beam.joints)
     model = result.model or {}
