@@ -18,6 +18,7 @@ import numpy as np
 from typing import TYPE_CHECKING
 
 from . import _validate as validate
+from .joint_points import describe_joints, joint_series
 from ._sections import output_directors, reference_points, section_outline, solid_points, wedge_cells
 
 if TYPE_CHECKING:
@@ -25,7 +26,7 @@ if TYPE_CHECKING:
     from .models import Beam
     from .result import Result
 
-__all__ = ["vtk", "beam_of", "bodies_of"]
+__all__ = ["vtk", "beam_of", "bodies_of", "joints_of"]
 
 logger = logging.getLogger("ancfdae")
 
@@ -124,6 +125,39 @@ def bodies_of(result: Result, beam: Beam | RigidBody | None = None) -> list[tupl
     return [(beam_of(result), slice(None))]
 
 
+def joints_of(result: Result, beam: Beam | RigidBody | None = None) -> list[dict]:
+    """The joint records of a System's result (:func:`ancfdae.joint_points.describe_joints`).
+
+    Parameters
+    ----------
+    result : Result
+        A run's result; its ``model`` description holds a System's joints.
+    beam : System, Beam or RigidBody, optional
+        When it is the System of the run, its joints are described directly.
+
+    Returns
+    -------
+    list of dict
+        One record per joint; empty without joints.
+    """
+    if beam is not None and hasattr(beam, "joints") and hasattr(beam, "bodies"):
+        return describe_joints(beam.bodies, beam.joints)
+    model = result.model or {}
+    return list(model.get("system", {}).get("joints", []) or [])
+
+
+def _joint_frames(result: Result, parts, records):
+    """``frame(i) -> meshio.Mesh`` of the joints as vertices with their unit ``axis`` and index ``joint``."""
+    import meshio
+    P, A = joint_series(records, parts, result.q)
+    cells = [("vertex", np.arange(len(records))[:, None])]
+    index = np.arange(len(records), dtype=float)
+
+    def frame(i):
+        return meshio.Mesh(P[i], cells, point_data={"axis": A[i], "joint": index})
+    return frame
+
+
 def _body_from_description(record: dict, where: str):
     from .bodies import RigidBody
     from .models import Beam
@@ -208,7 +242,10 @@ def vtk(result: Result, beam: Beam | RigidBody | None = None, directory: str | o
     1e-9), and per node (repeated on its section) ``axial_strain`` (``|r'| / |r'_ref| - 1``; BE2D,
     Cable3D, BE3D) or ``section_stretch_eta``/``_zeta`` (``|r_eta| - 1``; SQ). A rigid body is drawn as
     the homogeneous box of its mass and inertia (a quad in the plane) with ``displacement`` and the
-    exact ``velocity`` of its corners.
+    exact ``velocity`` of its corners. A System's joints (recorded in its result, :mod:`ancfdae.joint_points`)
+    are the last part: one vertex per joint at its first body side's point, with point data ``axis`` (the
+    unit axis of a revolute, prismatic or prescribed joint, zero otherwise) and ``joint`` (its index; the
+    ``.pvd`` names them in a comment).
     """
     import meshio       # on first use: 0.2-0.5 s to import (measured), and only the export needs it
     parts = bodies_of(result, beam)
@@ -222,6 +259,10 @@ def vtk(result: Result, beam: Beam | RigidBody | None = None, directory: str | o
     single = len(parts) == 1
     writers = [_rigid_frames(result, body, cols) if isinstance(body, RigidBody) else
                _beam_frames(result, body, cols, single) for body, cols in parts]
+    joints = joints_of(result, beam)
+    if joints:                       # the last part: the joints as points (index k = number of bodies)
+        writers.append(_joint_frames(result, parts, joints))
+        single = False
     entries = []
     for i in range(0, result.t.size, every):
         for k, frame in enumerate(writers):
@@ -231,6 +272,9 @@ def vtk(result: Result, beam: Beam | RigidBody | None = None, directory: str | o
     pvd = directory / f"{name}.pvd"
     lines = ['<?xml version="1.0"?>', '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
              "  <Collection>"]
+    if joints:
+        names = ", ".join(f"{k}: {j.get('name') or j['kind']}" for k, j in enumerate(joints)).replace("--", "- -")
+        lines.append(f"    <!-- part {len(parts)}: the joints {names} -->")
     lines += [f'    <DataSet timestep="{t!r}" group="" part="{k}" file={quoteattr(f)}/>' for t, k, f in entries]
     lines += ["  </Collection>", "</VTKFile>", ""]
     pvd.write_text("\n".join(lines))

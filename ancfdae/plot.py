@@ -19,7 +19,8 @@ from numpy.typing import ArrayLike
 
 from . import _validate as validate
 from ._sections import output_directors, section_outline, section_vectors
-from .export import bodies_of, beam_of
+from .export import bodies_of, beam_of, joints_of
+from .joint_points import joint_series
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -228,7 +229,8 @@ def animate(result: Result, path: str | os.PathLike, *, beam: Beam | RigidBody |
     Returns
     -------
     pathlib.Path
-        The file written. Frames share fixed axis limits (those of the whole motion).
+        The file written. Frames share fixed axis limits (those of the whole motion). A System's joints
+        (recorded in its result) are drawn as black dots.
     """
     path = validate.output_file("path", path, (".gif",))     # checked first: a bad path fails at once
     fps = validate.positive_int("fps", fps)
@@ -243,6 +245,8 @@ def animate(result: Result, path: str | os.PathLike, *, beam: Beam | RigidBody |
         raise ValueError("`result` has no outputs to animate.")
     parts = bodies_of(result, beam)
     frames = range(0, result.t.size, every)
+    joints = joints_of(result, beam)
+    joint_points = joint_series(joints, parts, result.q)[0] if joints else None
     fig = Figure(figsize=(6, 4))
     FigureCanvasAgg(fig)     # off-screen rendering, whatever backend pyplot uses
     three_d = _dim(parts[0][0]) == 3
@@ -267,6 +271,8 @@ def animate(result: Result, path: str | os.PathLike, *, beam: Beam | RigidBody |
             ax.clear()
             for (body, cols), d in zip(parts, directors):
                 configuration(body, result.q[i, cols], ax, directors=None if d is None else d[i])
+            if joint_points is not None:           # the joints as black dots
+                ax.scatter(*joint_points[i, :, :3 if three_d else 2].T, color="k", s=12, zorder=5)
             if not three_d:
                 ax.set_aspect("equal", adjustable="box")
             ax.set_xlim(lo[0], hi[0])

@@ -14,6 +14,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ancfdae.constrained import dependent_rows
+from ancfdae.joint_points import describe_joints
 from ancfdae.joints.assembled import ConstraintSet
 from ancfdae.joints.base import Frame, Joint
 from ancfdae.joints.rows import Affine, Rows
@@ -231,8 +232,10 @@ class System(BodyStack):
         return self.shared_capabilities() | {"constraints"}
 
     def describe(self) -> dict:
-        """JSON-able description: the bodies' and the constraint rows' labels."""
+        """JSON-able description: the bodies, the constraint rows' labels and the joints (for pictures,
+        :mod:`ancfdae.joint_points`)."""
         return {"system": {"bodies": [b.describe() if callable(getattr(b, "describe", None)) else
                                       {"type": type(b).__name__} for b in self.bodies],
                            "offsets": [int(o) for o in self.offsets],
-                           "constraint_labels": list(self.constraint_labels)}}
+                           "constraint_labels": list(self.constraint_labels),
+                           "joints": describe_joints(self.bodies, self.joints)}}

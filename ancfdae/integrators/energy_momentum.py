@@ -87,6 +87,7 @@ import scipy.sparse.linalg as spla
 from ancfdae import _validate as validate
 from ancfdae._scale import ENERGY_ROUNDOFF
 from ancfdae.integrators._alpha_index3 import mass_scale
+from ancfdae.integrators._body_gradient import BodyWiseGradient, has_bodies
 from ancfdae.integrators._discrete_gradient import AVFGradient, GonzalezGradient
 from ancfdae.integrators._em_constrained import constrained_em_step
 from ancfdae.kkt import KKTAssembler
@@ -156,7 +157,8 @@ class EnergyMomentum(NewtonStepper):
         validate.choice("discrete_gradient", discrete_gradient, DISCRETE_GRADIENTS)
         degree = getattr(model, "potential_degree", None)
         if discrete_gradient == "auto":
-            discrete_gradient = "avf" if degree is not None else "gonzalez"
+            # a System: body by body (momentum about the gravity axis kept; AVF is not rotation-equivariant)
+            discrete_gradient = "avf" if degree is not None and not has_bodies(model) else "gonzalez"
         if discrete_gradient == "avf" and degree is None:
             raise ValueError("`discrete_gradient` 'avf' needs a polynomial potential (model.potential_degree), "
                              f"got potential_degree=None for {type(model).__name__}; use 'gonzalez'.")
@@ -174,11 +176,17 @@ class EnergyMomentum(NewtonStepper):
         """
         self._model_bound = model
         self._M = sp.csr_matrix(model.mass(model.initial_state()[0]))
-        self._Mlu = spla.splu(sp.csc_matrix(self._M))
+        # M alone is factorised for the unconstrained step's acceleration only: a constrained model's M may be
+        # singular (a lamina's director), its accelerations come from the saddle-point (KKT) system.
+        constrained = "constraints" in capabilities(model)
+        self._Mlu = None if constrained or self.variable_mass else spla.splu(sp.csc_matrix(self._M))
         degree = getattr(model, "potential_degree", None)
-        self._dg = (AVFGradient(self.model, degree) if self.discrete_gradient == "avf"
-                    else GonzalezGradient(self.model, self._M,
-                                          rotations=self.angular_momentum and not self.variable_mass))
+        if self.discrete_gradient == "avf":
+            self._dg = AVFGradient(self.model, degree)
+        elif has_bodies(model) and self.angular_momentum and not self.variable_mass:
+            self._dg = BodyWiseGradient(model, counter=self.model)
+        else:
+            self._dg = GonzalezGradient(self.model, self._M, rotations=self.angular_momentum and not self.variable_mass)
         self._kin = KineticPart(self.model, self._M) if self.variable_mass else None
 
     def _setup(self):
@@ -276,7 +284,8 @@ class EnergyMomentum(NewtonStepper):
         evaluations count among ``residual_evals`` beside the model's (one per step, for the
         acceleration), and ``jacobian_evals`` are the evaluations of its matrix (a discrete
         gradient's Jacobian). ``potential_evals`` and ``potential_gradient_evals`` count the
-        model's calls (every discrete-gradient pass, Jacobians included).
+        model's calls (every discrete-gradient pass, Jacobians included; on a System with the body-wise
+        gradient, the bodies' calls).
         """
         st = super().stats
         st["residual_evals"] = self.newton.stats.residual_evals + self.model.n_residual
