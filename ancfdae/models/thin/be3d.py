@@ -171,18 +171,12 @@ class BE3D(Element):
         curvatures ``k2, k3`` (the diagonal of Eqs. 42/111).
     """
 
-
     name = "BE3D"
     dim = 3
     node_params = (-1.0, 1.0)
     node_coordinates = ("x", "y", "z", "x'", "y'", "z'", "theta")
     mass_is_constant = False
     kernel_twins = {"numpy": BE3DReference, "numba": _compiled}
-
-    dim = 3
-    node_params = (-1.0, 1.0)
-    node_coordinates = ("x", "y", "z", "x'", "y'", "z'", "theta")
-    mass_is_constant = False
 
     def __init__(self, material: Material, section: RectangularSection | CircularSection,
                  director_update: str = "projected", director: ArrayLike | None = None,
