@@ -177,6 +177,7 @@ class EnergyCollocation(NewtonStepper):
         self._bind()
         require_potential_split(self.model, self.t, self.q, self.v, self.name)
         self._constrained = "constraints" in capabilities(self.model)
+        self._stages = "potential_stages" in capabilities(self.model)
         if self._constrained:
             self._mscale = mass_scale(self._M)
             if self.lam is None:
@@ -204,12 +205,29 @@ class EnergyCollocation(NewtonStepper):
         """``sum_l BP[i, l] (grad P - f_nc)(sigma_l)``: the conservative force at the ``k`` nodes, the
         loads at the 2 Gauss nodes (the Gauss method's own rule: order 4, and the work of the loads is
         that rule's, handed to the monitors)."""
+        return self._force_terms(t0, h)(Y)
+
+    def _force_terms(self, t0, h):
+        """:meth:`_forces` of the step from ``(t0, q, v)`` as a function of ``Y`` alone: the nodes' parts that
+        do not depend on ``Y`` formed once per step, the ``k`` gradients in one model call where the model
+        offers it (capability ``"potential_stages"``: one compiled element pass), else one call per node."""
         m, co, ld = self.model, self._co, self._loads
-        ts, Q = self._nodes(t0, h, Y, co)
-        G = np.column_stack([m.potential_gradient(t, Q[:, l], False)[0] for l, t in enumerate(ts)])
-        ts, Q = self._nodes(t0, h, Y, ld)
-        F = np.column_stack([m.nonconservative_force(t, Q[:, l], False)[0] for l, t in enumerate(ts)])
-        return G @ co.BP.T - F @ ld.BP.T
+        ts, tl = t0 + co.c * h, t0 + ld.c * h
+        base, base_l = self.q[:, None] + np.outer(h * self.v, co.c), self.q[:, None] + np.outer(h * self.v, ld.c)
+        WqT, WlT, BPT, BlT = co.Wq.T.copy(), ld.Wq.T.copy(), co.BP.T.copy(), ld.BP.T.copy()
+        stages, gradient, load = self._stages, m.potential_gradient, m.nonconservative_force
+
+        def forces(Y):
+            Q = base + Y @ WqT
+            if stages:
+                G = m.potential_gradient_stages(ts, Q)
+            else:
+                G = np.column_stack([gradient(t, Q[:, l], False)[0] for l, t in enumerate(ts)])
+            Q = base_l + Y @ WlT
+            F = np.column_stack([load(t, Q[:, j], False)[0] for j, t in enumerate(tl)])
+            return G @ BPT - F @ BlT
+
+        return forces
 
     def _exact(self, t0, h, Y):
         """The exact Jacobian ``delta_im M / h^2 + sum_l C[i, m, l] H_l - sum_j Cnc[i, m, j] Kf_j`` (Hessians
@@ -255,9 +273,11 @@ class EnergyCollocation(NewtonStepper):
         M, ih2 = self._M, 1.0 / (h * h)
         zn = np.zeros(n)
 
+        forces = self._force_terms(t0, h)
+
         def residual(x):
             Y = x.reshape(n, _S)
-            return (ih2 * (M @ Y) + self._forces(t0, h, Y)).ravel()
+            return (ih2 * (M @ Y) + forces(Y)).ravel()
 
         def jacobian(x):
             Y = x.reshape(n, _S)
