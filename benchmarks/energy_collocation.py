@@ -8,7 +8,7 @@
     step, the energy's spread after the load relative to the energy; then the CPU time at equal
     eps_T (log-log interpolation along each method's sweep, no extrapolation) and its ratio to
     Lobatto IIIA-3's. Runs are cached as JSON in ``--out`` (rerun to complete a sweep).
-``python -m benchmarks.energy_collocation long [--steps 10000] [--elements 1]``
+``python -m benchmarks.energy_collocation long [--steps 10000] [--elements 1] [--silent-stages auto]``
     energy drift over ``--steps`` free steps (h = 10 ms) after a short load, every constant-mass
     element and formulation (as ``tests/integrators/test_energy_collocation.py`` with fewer steps).
 ``python -m benchmarks.energy_collocation stages [--problem B3-8] [--h 1e-2] [--t-end 10]``
@@ -178,7 +178,7 @@ def long_runs(a):
             beam = models.Beam(el, a.elements, 1.0, start=(0.0, 0.0, 0.0), direction=(0.6, 0.8, 0.0),
                                loads=[PointMoment((0.1, 0.05, 0.2), node=0, time=hat(t_load / 2))])
         c0 = time.process_time()
-        res = simulate(beam, (0.0, t_load + a.steps * h), "energy-collocation", h=h)
+        res = simulate(beam, (0.0, t_load + a.steps * h), "energy-collocation", h=h, silent_stages=a.silent_stages)
         E = np.array([beam.energy(t, q, v).total for t, q, v in zip(res.t, res.q, res.v) if t >= t_load - 1e-12])
         print(f"{name:<8}{kw.get('formulation', 'default'):<18}k = {res.options['silent_stages']}  "
               f"{'ok' if res.success else 'FAILED'}  free steps {E.size - 1}  "
@@ -204,6 +204,8 @@ def main(argv=None):
     ap.add_argument("--k", type=int, nargs="+", default=[4, 5, 6])
     ap.add_argument("--steps", type=int, default=10_000)
     ap.add_argument("--elements", type=int, default=1)
+    ap.add_argument("--silent-stages", default="auto", type=lambda x: x if x == "auto" else int(x),
+                    help="long: k (default 'auto')")
     ap.add_argument("--cases", nargs="+", default=None, help="long: only these (e.g. SQ3D SQ3D-continuum)")
     ap.add_argument("--h-ref", type=float, default=None, help="step of the reference run (default: a quarter of the finest)")
     ap.add_argument("--out", type=Path, default=Path("out/energy_collocation"))

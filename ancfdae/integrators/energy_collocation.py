@@ -74,7 +74,8 @@ __all__ = ["EnergyCollocation", "SMOOTH_SILENT_STAGES", "ITERATION_MATRICES"]
 
 #: Silent stages for a potential that is not a polynomial (chosen by measurement, see docs/energy_momentum.md:
 #: one element, 1000 steps of 10 ms, energy drift SQ3D structural 3.6e-11 / 6.6e-14 / 3.8e-14 at k = 4 / 5 / 6,
-#: SQ2D structural 1.8e-12 / 1.2e-14 / 1.4e-14; B3 8 SQ3D, h = 5 ms: 8.5e-14 at k = 5, 9.0e-14 at k = 6).
+#: SQ2D structural 2.0e-13 / 3.1e-14 / 3.0e-14, BE2D 8.4e-14 / 3.9e-14 / 4.3e-14; B3 8 SQ3D, h = 5 ms: 8.5e-14
+#: at k = 5, 9.0e-14 at k = 6).
 SMOOTH_SILENT_STAGES = 5
 ITERATION_MATRICES = ("split", "exact")
 _S = 2          # fundamental stages: order 4
