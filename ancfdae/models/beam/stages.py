@@ -111,7 +111,7 @@ class StageEvaluator:
         return R
 
 
-def potential_gradient_stages(beam, ts, Q: np.ndarray) -> np.ndarray:
+def potential_gradient_stages(beam: "ancfdae.models.Beam", ts: np.ndarray, Q: np.ndarray) -> np.ndarray:
     """``G[:, i] = beam.potential_gradient(ts[i], Q[:, i], False)[0]`` for ``m`` configurations in one element
     pass (the ``"potential_stages"`` capability of :mod:`ancfdae.problem`; the energy-preserving collocation
     evaluates the conservative force at its ``k`` silent stages with it), shape (n_dof, m)."""
