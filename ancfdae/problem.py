@@ -157,6 +157,10 @@ class Model(Protocol):
 #:     ``potential``, ``potential_gradient``, ``nonconservative_force`` (and optionally
 #:     ``symmetry_generators``, ``potential_degree``), see :class:`PotentialModel`
 #:     (energy-momentum integrators).
+#: ``"potential_stages"``
+#:     with ``"potential"``: ``potential_gradient_stages(ts, Q) -> G`` of shape ``(n_dof, m)``, column ``i``
+#:     ``potential_gradient(ts[i], Q[:, i], False)[0]``: ``m`` configurations in one call (the
+#:     energy-preserving collocation's silent stages).
 #: ``"constraints"``
 #:     holonomic constraints ``g(t, q) = 0`` (``n_constraints`` rows); the equations of motion become
 #:     ``r(t, q, v, a) + G^T lam = 0``, ``g = 0`` (``residual`` stays without ``G^T lam``):
@@ -176,6 +180,7 @@ CAPABILITIES: dict[str, tuple[str, ...]] = {
     "mass_forms": ("mass_action", "mass_bilinear"),
     "step_events": ("event_state", "bind", "step_event"),
     "potential": ("potential", "potential_gradient", "nonconservative_force"),
+    "potential_stages": ("potential_gradient_stages",),
     "constraints": ("constraints", "constraint_jacobian", "constraint_force_jacobian", "constraint_rates"),
 }
 

@@ -8,9 +8,12 @@
     step, the energy's spread after the load relative to the energy; then the CPU time at equal
     eps_T (log-log interpolation along each method's sweep, no extrapolation) and its ratio to
     Lobatto IIIA-3's. Runs are cached as JSON in ``--out`` (rerun to complete a sweep).
-``python -m benchmarks.energy_collocation long [--steps 10000] [--elements 1]``
+``python -m benchmarks.energy_collocation long [--steps 10000] [--elements 1] [--silent-stages auto]``
     energy drift over ``--steps`` free steps (h = 10 ms) after a short load, every constant-mass
     element and formulation (as ``tests/integrators/test_energy_collocation.py`` with fewer steps).
+``python -m benchmarks.energy_collocation ratio --problem B3-8 [--h 5e-3] [--t-end 5] [--reps 3]``
+    CPU time of energy-collocation over Lobatto IIIA-3's at one step: medians of ``--reps`` runs of each,
+    interleaved in one process (equal h is equal accuracy: see ``wp``).
 ``python -m benchmarks.energy_collocation stages [--problem B3-8] [--h 1e-2] [--t-end 10]``
     the energy's spread after the load against the number of silent stages ``k``.
 
@@ -178,13 +181,34 @@ def long_runs(a):
             beam = models.Beam(el, a.elements, 1.0, start=(0.0, 0.0, 0.0), direction=(0.6, 0.8, 0.0),
                                loads=[PointMoment((0.1, 0.05, 0.2), node=0, time=hat(t_load / 2))])
         c0 = time.process_time()
-        res = simulate(beam, (0.0, t_load + a.steps * h), "energy-collocation", h=h)
+        res = simulate(beam, (0.0, t_load + a.steps * h), "energy-collocation", h=h, silent_stages=a.silent_stages)
         E = np.array([beam.energy(t, q, v).total for t, q, v in zip(res.t, res.q, res.v) if t >= t_load - 1e-12])
         print(f"{name:<8}{kw.get('formulation', 'default'):<18}k = {res.options['silent_stages']}  "
               f"{'ok' if res.success else 'FAILED'}  free steps {E.size - 1}  "
               f"max|E - E0|/|E| = {np.ptp(E) / np.abs(E).max():.2e}  "
               f"its/step {res.stats['newton_iterations'] / res.stats['steps']:.2f}  "
               f"CPU {time.process_time() - c0:.0f} s", flush=True)
+
+
+def ratio(a):
+    build = PROBLEMS[a.problem][0]
+    for m in ("lobatto3", "energy-collocation"):                 # compile before timing
+        model = build()
+        simulate(model, (0.0, 0.05), **method_of(m, model, a.h), monitors=[EnergyMonitor()])
+    cpu = {"lobatto3": [], "energy-collocation": []}
+    for _ in range(a.reps):
+        for m in cpu:
+            model = build()
+            c0 = time.process_time()
+            res = simulate(model, (0.0, a.t_end), **method_of(m, model, a.h), monitors=[EnergyMonitor()])
+            cpu[m].append(time.process_time() - c0)
+            st = res.stats
+            print(f"{m:<20}{'ok' if res.success else 'FAILED'}  CPU {cpu[m][-1]:6.2f} s  it/step "
+                  f"{st['newton_iterations'] / st['steps']:.2f}  LU/step {st['factorizations'] / st['steps']:.3f}",
+                  flush=True)
+    lo, ec = np.median(cpu["lobatto3"]), np.median(cpu["energy-collocation"])
+    print(f"{a.problem} h = {a.h:g}, [0, {a.t_end:g}] s: median CPU Lobatto IIIA-3 {lo:.2f} s, energy-collocation "
+          f"{ec:.2f} s, ratio {ec / lo:.2f}")
 
 
 def stages(a):
@@ -196,21 +220,24 @@ def stages(a):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("what", choices=("wp", "long", "stages"))
+    ap.add_argument("what", choices=("wp", "long", "stages", "ratio"))
     ap.add_argument("--problem", default="B2-4", choices=tuple(PROBLEMS))
     ap.add_argument("--methods", nargs="+", default=None)
     ap.add_argument("--t-end", type=float, default=None)
     ap.add_argument("--h", type=float, default=1e-2)
     ap.add_argument("--k", type=int, nargs="+", default=[4, 5, 6])
     ap.add_argument("--steps", type=int, default=10_000)
+    ap.add_argument("--reps", type=int, default=3, help="ratio: runs of each method")
     ap.add_argument("--elements", type=int, default=1)
+    ap.add_argument("--silent-stages", default="auto", type=lambda x: x if x == "auto" else int(x),
+                    help="long: k (default 'auto')")
     ap.add_argument("--cases", nargs="+", default=None, help="long: only these (e.g. SQ3D SQ3D-continuum)")
     ap.add_argument("--h-ref", type=float, default=None, help="step of the reference run (default: a quarter of the finest)")
     ap.add_argument("--out", type=Path, default=Path("out/energy_collocation"))
     a = ap.parse_args(argv)
     if a.t_end is None:
         a.t_end = 4.0 if a.problem.startswith("B2") else 5.0
-    {"wp": work_precision, "long": long_runs, "stages": stages}[a.what](a)
+    {"wp": work_precision, "long": long_runs, "stages": stages, "ratio": ratio}[a.what](a)
 
 
 if __name__ == "__main__":

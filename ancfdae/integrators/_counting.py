@@ -94,6 +94,11 @@ class CountingModel:
         self.n_potential_gradient += 1
         return self.wrapped.potential_gradient(t, q, tangent)
 
+    def potential_gradient_stages(self, ts, Q):
+        """The wrapped model's ``potential_gradient_stages``, counted as one gradient per configuration."""
+        self.n_potential_gradient += len(ts)
+        return self.wrapped.potential_gradient_stages(ts, Q)
+
     # -- forwarded ----------------------------------------------------------------------------
     def __getattr__(self, name):
         # Only for names not defined above (mass, n_dof, event_state, nonconservative_force, ...).

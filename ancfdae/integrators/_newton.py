@@ -34,6 +34,12 @@ __all__ = ["NewtonSolver", "max_abs"]
 #: A rate above this with a matrix evaluated during the current attempt counts
 #: as divergence; two such iterations in a row end the attempt early.
 DIVERGENCE_RATE = 1.0
+#: An ``accept`` test failed by at most this factor converges after one more correction from the residual at
+#: hand, without evaluating a new one: modified Newton shrinks what ``accept`` measures by its rate (0.03 to
+#: 0.1 on the energy-preserving collocation's steps). Measured there (one SQ3D element, 1000 steps of 10 ms,
+#: residuals per step): energy drift 3.8e-14 with 10.6; 6.0e-15 with 11.2 at factor 10; 4.3e-15 with 12.1
+#: iterating on every time; 4.9e-13 with 10.4 for the residual test alone.
+ACCEPT_AFTER_CORRECTION = 100.0
 
 
 @njit(cache=True)
@@ -151,6 +157,7 @@ class NewtonSolver:
         floor_update: str = "max",
         residual_jacobian: Callable[[np.ndarray], tuple] | None = None,
         iterate: Callable | None = None,
+        accept: Callable[[np.ndarray, np.ndarray], bool] | None = None,
     ) -> NewtonOutcome:
         """Iterate from ``x0`` until the residual test passes.
 
@@ -190,6 +197,15 @@ class NewtonSolver:
             :mod:`ancfdae.models.beam.iteration_numba`; :mod:`ancfdae.integrators._alpha_iteration`);
             modified Newton only.
 
+        accept : callable, optional
+            ``accept(x, r) -> float``, asked once the residual test passes or the residual stagnates
+            (``r`` the residual at ``x``): how many times a quantity exceeds its allowance. At most 1:
+            converged; at most :data:`ACCEPT_AFTER_CORRECTION`: converged after one more correction
+            (no new residual); else the iteration carries on with the same matrix while the correction
+            still halves, converging when it no longer does (the attainable accuracy) or ``accept``
+            agrees. The energy-preserving collocation asks for its energy identity to round-off with
+            it. Python iterations only (not with ``iterate``).
+
         Returns
         -------
         NewtonOutcome
@@ -214,7 +230,8 @@ class NewtonSolver:
             return NewtonOutcome(x0, False, 0, float("nan"), "residual at the initial guess is not finite", floor)
         if fused is not None:
             iterate = None
-        outcome, stale = self._attempt(residual, jacobian, x0, r, residual_atol, floor, keep_max, fused, J, iterate)
+        outcome, stale = self._attempt(residual, jacobian, x0, r, residual_atol, floor, keep_max, fused, J, iterate,
+                                       accept)
         if (not outcome.converged and stale and self.options.jacobian == "modified"
                 and self.options.retry):
             # The failed attempt started from a matrix of an earlier solve:
@@ -223,7 +240,7 @@ class NewtonSolver:
             self.invalidate()
             first = outcome
             retry, _ = self._attempt(residual, jacobian, x0, r, residual_atol, first.floor, keep_max,
-                                     iterate=iterate)
+                                     iterate=iterate, accept=accept)
             outcome = NewtonOutcome(retry.x, retry.converged, first.iterations + retry.iterations,
                                     retry.residual_norm,
                                     retry.message if retry.converged else
@@ -233,7 +250,8 @@ class NewtonSolver:
             self.stats.failed_solves += 1
         return outcome
 
-    def _attempt(self, residual, jacobian, x0, r, atol, floor, keep_max, fused=None, J=None, iterate=None):
+    def _attempt(self, residual, jacobian, x0, r, atol, floor, keep_max, fused=None, J=None, iterate=None,
+                 accept=None):
         """One Newton attempt; returns (outcome, started_with_stale_matrix).
 
         With ``fused`` (full Newton and a ``residual_jacobian``), ``J`` is the
@@ -249,8 +267,10 @@ class NewtonSolver:
         err0 = err = max_abs(r)
         rel = max(opts.tol * err0, atol)
         threshold = max(rel, floor)
-        if err <= threshold:
+        if err <= threshold and (accept is None or accept(x, r) <= 1.0):
             return NewtonOutcome(x, True, 0, err, "converged at the initial guess", floor), stale
+        polish = err <= threshold   # below the residual test, not accepted: iterate on while the correction halves
+        dx_last = np.inf
         fresh = False  # the cached matrix was evaluated during this attempt
         diverging = 0
         k = 0
@@ -292,14 +312,28 @@ class NewtonSolver:
             if not math.isfinite(err_new):
                 return NewtonOutcome(x, False, k, float("nan"),
                                      f"residual became non-finite at iteration {k}", floor), stale
-            if err_new <= threshold:
-                return NewtonOutcome(x, True, k, err_new, f"converged in {k} iterations", floor), stale
             # Round-off stagnation: a fresh matrix, a correction at round-off
             # level and a residual that no longer falls -- the attainable accuracy.
-            if (fresh and err_new > 0.5 * err
-                    and dx_max <= opts.xtol * max(1.0, max_abs(x))):
+            stagnant = (err_new > threshold and fresh and err_new > 0.5 * err
+                        and dx_max <= opts.xtol * max(1.0, max_abs(x)))
+            if accept is None and err_new <= threshold:
+                return NewtonOutcome(x, True, k, err_new, f"converged in {k} iterations", floor), stale
+            if accept is None and stagnant:
                 return NewtonOutcome(x, True, k, err_new, f"converged in {k} iterations "
                                      f"(correction at round-off level, max|r| = {err_new:.3e})", floor), stale
+            if accept is not None and (polish or stagnant or err_new <= threshold):
+                ratio = accept(x, r)
+                if ratio <= 1.0:
+                    return NewtonOutcome(x, True, k, err_new, f"converged in {k} iterations", floor), stale
+                if ratio <= ACCEPT_AFTER_CORRECTION:
+                    self.stats.iterations += 1
+                    return NewtonOutcome(x - self._lu.solve(r), True, k + 1, err_new, f"converged in {k + 1} "
+                                         "iterations (the last one without its residual)", floor), stale
+                if polish and not dx_max <= 0.5 * dx_last:
+                    return NewtonOutcome(x, True, k, err_new, f"converged in {k} iterations (the correction "
+                                         f"stalled at round-off, max|dx| = {dx_max:.3e})", floor), stale
+                polish, dx_last, err = True, dx_max, err_new
+                continue           # the matrix kept: a residual at its floor says nothing about the rate
             rate = err_new / err if err > 0 else np.inf
             err = err_new
             if rate > opts.contraction:
@@ -314,6 +348,9 @@ class NewtonSolver:
                     self._lu = None  # refresh at the current iterate
             else:
                 diverging = 0
+        if polish:
+            return NewtonOutcome(x, True, opts.max_iter, err, f"converged in {opts.max_iter} iterations (at the "
+                                 "residual's floor, the correction still halving)", floor), stale
         return NewtonOutcome(x, False, opts.max_iter, err,
                              f"not converged in {opts.max_iter} iterations "
                              f"(max|r| = {err:.3e}, target {threshold:.3e})", floor), stale

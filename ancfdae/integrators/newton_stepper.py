@@ -134,15 +134,16 @@ class NewtonStepper(FixedStepIntegrator):
         """
         return roundoff_floor(self.FLOOR_ROUNDOFF, K, q)
 
-    def _solve(self, residual, jacobian, x0, iterate=None) -> NewtonOutcome:
+    def _solve(self, residual, jacobian, x0, iterate=None, accept=None) -> NewtonOutcome:
         """Newton with the run's absolute tolerance and the floor carried from the earlier solves.
 
         ``jacobian(x)`` returns ``(matrix, self.floor_of(K, q))``; ``iterate``: the compiled iteration
-        (see :meth:`NewtonSolver.solve`), or None. The outcome has ``x``,
+        (see :meth:`NewtonSolver.solve`), or None; ``accept``: the solver's test after the residual's (ditto).
+        The outcome has ``x``,
         ``converged``, ``iterations``, ``residual_norm``, ``message`` and ``floor``.
         """
         out = self.newton.solve(residual, jacobian, x0, residual_atol=self._atol, floor=self._floor,
-                                floor_update=self.FLOOR_UPDATE, iterate=iterate)
+                                floor_update=self.FLOOR_UPDATE, iterate=iterate, accept=accept)
         self._floor = out.floor
         return out
 

@@ -33,7 +33,7 @@ from .compiled import compiled_residual
 from .loads import LoadSet, load_sequence
 from .mass_forms import MassForms
 from .potential import symmetry_generators
-from .stages import StageEvaluator
+from .stages import StageEvaluator, potential_gradient_stages
 
 __all__ = ["Beam"]
 
@@ -195,7 +195,7 @@ class Beam(MassForms):
         """The optional capabilities this beam offers (see :func:`ancfdae.problem.capabilities`)."""
         caps = {"residual_jacobian", "residual_stages"}
         if self.mass_is_constant or callable(getattr(self.element, "mass_bilinear", None)):
-            caps.add("potential")       # d/dt(M v) - dT/dq + dP/dq - f_nc; M constant or with its forms
+            caps |= {"potential", "potential_stages"}   # d/dt(M v) - dT/dq + dP/dq - f_nc; constant M or its forms
         if not self.mass_is_constant:
             caps |= {"variable_mass"} | ({"mass_forms"} if "potential" in caps else set())
         if self.element.event_state(self.geom):
@@ -348,8 +348,7 @@ class Beam(MassForms):
         """Residuals of several stages in one element pass: column ``i`` of the (n_dof, m) result is
         ``residual(ts[i], Q[:, i], V[:, i], A[:, i])`` (optional Model method; Lobatto IIIA uses it).
 
-        A constant-mass beam runs the element kernel once on the stages' elements stacked
-        (:class:`.stages.StageEvaluator`), which halves the per-call overhead of small meshes.
+        A constant-mass beam runs the kernel once on the stages' elements stacked (:class:`.stages.StageEvaluator`).
         """
         m = np.size(ts)
         if np.ndim(ts) != 1 or np.shape(Q) != (self.n_dof, m) or np.shape(V) != (self.n_dof, m) \
@@ -368,6 +367,7 @@ class Beam(MassForms):
         return self._stages.residuals(Q, A, F_ext, float(self.load_factor))
 
     compiled_residual = compiled_residual   # the residual as compiled pieces, or None (:mod:`.compiled`)
+    potential_gradient_stages = potential_gradient_stages   # k configurations in one pass (:mod:`.stages`)
 
     # -- the potential capability (ancfdae.problem.PotentialModel) ---------
     @property

@@ -7,9 +7,10 @@ import functools
 
 import numpy as np
 
+from ..._validate import check_shape
 from .assembly import Assembler
 
-__all__ = ["StageEvaluator"]
+__all__ = ["StageEvaluator", "potential_gradient_stages"]
 
 
 @functools.cache
@@ -64,6 +65,27 @@ class StageEvaluator:
             self._cache[m] = (geom, gather, idx, np.repeat(self._q_fixed, m))
         return self._cache[m]
 
+    def gradients(self, Q: np.ndarray) -> np.ndarray:
+        """``G[:, i] = dU/dq(Q[:, i])`` of ``m`` configurations, shape (n_dof, m), from one element pass.
+
+        The same sums in the same order as :meth:`Beam.internal_forces` per column (the stacked copies
+        are scattered copy by copy, elements in mesh order): equal bits.
+        """
+        n, m = Q.shape
+        geom, gather, idx, q_fixed_m = self._stacked(m)
+        fused = self.element.fused_kernel(geom)
+        if fused is None:
+            ext = np.empty((n + self._q_fixed.size, m))
+            ext[:n] = Q
+            ext[n:] = self._q_fixed[:, None]
+            fe, _ = self.element.internal_forces(geom, ext.ravel().take(gather), False)
+            return np.bincount(idx, weights=fe.ravel(), minlength=m * (n + 1)).reshape(m, n + 1)[:, :n].T
+        fn, args = fused
+        F = np.empty((m, n + 1))
+        fn(np.ascontiguousarray(Q, dtype=float).reshape(-1), q_fixed_m, gather, idx, self._asm._slot_all, False,
+           F.reshape(-1), self._no_k, *args)
+        return F[:, :n].T
+
     def residuals(self, Q: np.ndarray, A: np.ndarray, F_ext: np.ndarray, load_factor: float) -> np.ndarray:
         """``R[:, i] = f(Q[:, i]) + M A[:, i] - load_factor F_ext[:, i]``, shape (n_dof, m)."""
         n, m = Q.shape
@@ -87,3 +109,15 @@ class StageEvaluator:
         _finish_stages()(F, self._mass_data, self._asm.indptr, self._asm.indices, np.ascontiguousarray(A, dtype=float),
                          float(load_factor), F_ext, R)
         return R
+
+
+def potential_gradient_stages(beam: "ancfdae.models.Beam", ts: np.ndarray, Q: np.ndarray) -> np.ndarray:
+    """``G[:, i] = beam.potential_gradient(ts[i], Q[:, i], False)[0]`` for ``m`` configurations in one element
+    pass (the ``"potential_stages"`` capability of :mod:`ancfdae.problem`; the energy-preserving collocation
+    evaluates the conservative force at its ``k`` silent stages with it), shape (n_dof, m)."""
+    m = np.size(ts)
+    if np.ndim(ts) != 1 or np.shape(Q) != (beam.n_dof, m):
+        check_shape("ts", ts, (m,), "one time per configuration")
+        check_shape("Q", Q, (beam.n_dof, m), f"(n_dof, number of configurations) = ({beam.n_dof}, {m})")
+    G = beam._stages.gradients(Q)
+    return G - beam.load_factor * beam._load_set.gravity[:, None]
