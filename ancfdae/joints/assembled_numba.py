@@ -22,7 +22,7 @@ import scipy.sparse as sp
 from numba import njit
 
 from ancfdae.joints.assembled import ConstraintSet
-from ancfdae.models.beam.assembly import _fast_csr
+from ancfdae.models.beam.assembly import fast_csr
 
 __all__ = ["CompiledConstraintSet"]
 
@@ -114,7 +114,7 @@ class CompiledConstraintSet(ConstraintSet):
 
     def _csr(self, pattern, data):
         # the pattern is canonical and fixed: skip scipy's format checks (~25 us a matrix)
-        return _fast_csr(data, pattern.indices, pattern.indptr, pattern.shape)
+        return fast_csr(data, pattern.indices, pattern.indptr, pattern.shape)
 
     def terms_at(self, t: float) -> Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]:
         """``(q, lam) -> (g(t, q), G(t, q)^T lam)`` with the time functions evaluated once, at ``t`` (the

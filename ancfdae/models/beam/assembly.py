@@ -11,7 +11,7 @@ import scipy.sparse as sp
 
 from .pattern_numba import diagonal_slots, element_slots, row_columns
 
-__all__ = ["Assembler", "entry_pattern", "node_pattern", "element_nodes_of"]
+__all__ = ["Assembler", "entry_pattern", "node_pattern", "element_nodes_of", "fast_csr"]
 
 
 def _checked_csr(data, indices, indptr, shape):
@@ -43,7 +43,9 @@ def _select_csr_builder():
         return _checked_csr
 
 
-_fast_csr = _select_csr_builder()
+#: CSR matrix from (data, indices, indptr, shape) on a pattern built here: the unchecked constructor where it
+#: behaves exactly like scipy's (checked once at import), shared by the beam and the joints' compiled rows.
+fast_csr = _select_csr_builder()
 
 
 def entry_pattern(fe: np.ndarray, n_free: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -168,7 +170,7 @@ class Assembler:
         analyses (e.g. the band map) by identity; it skips scipy's format
         checks, which cost more than the assembly itself on small meshes.
         """
-        return _fast_csr(data, self.indices, self.indptr, (self.n_free, self.n_free))
+        return fast_csr(data, self.indices, self.indptr, (self.n_free, self.n_free))
 
     def matrix(self, ke: np.ndarray) -> sp.csr_matrix:
         """Assemble element matrices into a CSR matrix with the fixed pattern."""

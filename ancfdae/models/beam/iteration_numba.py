@@ -30,22 +30,10 @@ from numba import njit
 
 from ...integrators._affine import affine3
 from ...integrators._linsolve_numba import band_solve
+from ...integrators._newton import max_abs
 from .assembly_numba import finish_residual
 
 __all__ = ["alpha_update", "alpha_finish", "carry_on"]
-
-
-@njit(cache=True)
-def _max_abs(x):
-    """``max|x|``, NaN if any entry is NaN (as :func:`ancfdae.integrators._newton.max_abs`)."""
-    m = 0.0
-    for v in x:
-        a = abs(v)
-        if a != a:
-            return a
-        if a > m:
-            m = a
-    return m
 
 
 @njit(cache=True)
@@ -54,7 +42,7 @@ def alpha_update(x, r, lub, kl, ku, piv, qa0, va0, aa0, cqa, cva, caa):
     finite) and the weighted state of the new ``x``."""
     dx = r.copy()
     band_solve(lub, kl, ku, piv, dx)
-    dx_max = _max_abs(dx)
+    dx_max = max_abs(dx)
     if dx_max == dx_max and dx_max != np.inf:
         for i in range(x.size):
             x[i] = x[i] - dx[i]
@@ -68,7 +56,7 @@ def alpha_finish(r, rbuf, m_data, indptr, indices, a, lam, f_ext):
     finish_residual(rbuf, m_data, indptr, indices, a, lam, f_ext)
     for i in range(r.size):
         r[i] = rbuf[i]
-    return _max_abs(r)
+    return max_abs(r)
 
 
 @njit(cache=True)
