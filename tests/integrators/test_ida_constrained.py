@@ -6,7 +6,7 @@ from ancfdae.integrators import IDA
 from ancfdae.integrators.ida_constrained import MULTIPLIER_ATOL, GGLResidual
 from support.numerics import fd_gradient
 from support.toy_constrained import (WithoutVelocityJacobian, consistent_start, double_pendulum, hanging_link, hub,
-                                     reference)
+                                     reference, step_to)
 
 T = 0.25
 PROBLEMS = {"pendulum": double_pendulum, "link": hanging_link, "hub": hub,
@@ -18,14 +18,7 @@ def run(model, rtol, linsolver="auto"):
     st = IDA(model, rtol=rtol, linsolver=linsolver)
     q0, v0, a0, l0 = consistent_start(model)
     st.initialize(model, 0.0, q0, v0, a0, T, lam0=l0)
-    g = gv = 0.0
-    while st.t < T:
-        out = st.step()
-        assert out.ok, out.message
-        st.accept(out)
-        g = max(g, np.abs(model.constraints(st.t, st.q)).max())
-        gv = max(gv, np.abs(model.constraint_jacobian(st.t, st.q) @ st.v
-                            + model.constraint_rates(st.t, st.q, st.v)[0]).max())
+    g, gv = step_to(st, model, T)
     return st, g, gv
 
 

@@ -6,7 +6,7 @@ from ancfdae.integrators import Lobatto3, NewtonOptions
 from ancfdae.integrators.lobatto_constrained import GGLStages
 from support.numerics import fd_gradient
 from support.toy_constrained import (WithoutVelocityJacobian, consistent_start, double_pendulum, hanging_link, hub,
-                                     kkt, reference)
+                                     kkt, reference, step_to)
 
 T = 0.25
 STEPS = (20, 40, 80)
@@ -17,14 +17,7 @@ def run(model, h, t_end=T, newton=None, lam0=True):
     st = Lobatto3(model, h, newton=newton)
     q0, v0, a0, l0 = consistent_start(model)
     st.initialize(model, 0.0, q0, v0, a0, t_end, lam0=l0 if lam0 else None)
-    g = gv = 0.0
-    while st.t < t_end - 1e-12:
-        out = st.step()
-        assert out.ok, out.message
-        st.accept(out)
-        g = max(g, np.abs(model.constraints(st.t, st.q)).max())
-        gv = max(gv, np.abs(model.constraint_jacobian(st.t, st.q) @ st.v
-                            + model.constraint_rates(st.t, st.q, st.v)[0]).max())
+    g, gv = step_to(st, model, t_end)
     return st, g, gv
 
 

@@ -332,3 +332,17 @@ def reference(model, times, rtol=1e-12):
     Y = sol.y.T
     lam = np.array([kkt(model, t, y[:n], y[n:])[1] for t, y in zip(times, Y)])
     return Y[:, :n], Y[:, n:], lam
+
+
+def step_to(st, model, t_end):
+    """Step an initialized constrained stepper ``st`` to ``t_end`` (every step must succeed); returns the largest
+    position residual ``|g|`` and velocity residual ``|G v + g_t|`` seen after a step."""
+    g = gv = 0.0
+    while st.t < t_end - 1e-12:
+        out = st.step()
+        assert out.ok, out.message
+        st.accept(out)
+        g = max(g, np.abs(model.constraints(st.t, st.q)).max())
+        gv = max(gv, np.abs(model.constraint_jacobian(st.t, st.q) @ st.v
+                            + model.constraint_rates(st.t, st.q, st.v)[0]).max())
+    return g, gv
