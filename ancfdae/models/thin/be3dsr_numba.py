@@ -17,7 +17,7 @@ from numba import njit
 
 from ..element import OnePassKernel
 from ..jets import vector_numba as vj
-from .be3d_moment_numba import be3d_moment
+from .be3d_numba import BE3DCompiled
 from .rotary_numba import rotary_bilinear, rotary_energy, rotary_force
 from .spatial_numba import axial_point
 
@@ -315,15 +315,8 @@ class BE3DSRCompiled(OnePassKernel):
                              np.ascontiguousarray(geom["k_ref"]), el.curvature_stiffness, el.EA, order)
         return U, f, (Kt if order >= 2 else None)
 
-    def moment_load(self, geom: dict, q: np.ndarray, s: float, moment: np.ndarray, element: int,
-                    tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        """BE3D's compiled dead moment (the frames at the nodes are BE3D's)."""
-        rule = geom["bend"]
-        directors = _directors(geom)
-        f, Km = be3d_moment(np.ascontiguousarray(q, dtype=float), rule.dof_map, rule.theta, float(s),
-                            float(geom["L"][element]), directors[element], directors[element + 1], moment,
-                            bool(tangent))
-        return f, (Km if tangent else None)
+    # The dead moment acts through the nodal frames, which BE3DSR shares with BE3D: BE3D's compiled load.
+    moment_load = BE3DCompiled.moment_load
 
     def _rotary(self, geom, q, v, acc, mode, order):
         rule = geom["inertia"]
