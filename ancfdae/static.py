@@ -14,6 +14,7 @@ from scipy.linalg import LinAlgWarning
 from . import _static_checks
 from . import _validate as validate
 from ._scale import absolute_tolerance
+from ._static_compiled import CompiledStatic
 from .integrators._newton import NewtonSolver
 from .integrators._newton_records import RENAMED_ATOL, NewtonOptions
 from .problem import Model, capabilities
@@ -176,11 +177,21 @@ def solve_static(model: Model, load_steps: int = 10, *, t: float = 0.0, q0: Arra
     saved = getattr(model, "load_factor", None)
     steps, status, message = [], "success", f"converged in {load_steps} load steps"
     start = _time.process_time()
+    compiled = CompiledStatic.offer(m, t, jacobian, bool(state))   # a load step in one compiled call, or None
     try:
         for i in range(1, load_steps + 1):
             lam = i / load_steps
             if saved is not None:
                 m.load_factor = saved * lam
+            if compiled is not None:
+                out = compiled.solve(solver, q, residual_atol)
+                steps.append({"load_factor": lam, "iterations": out.iterations, "residual": out.residual_norm,
+                              "converged": out.converged, "q": out.x if out.converged else q.copy()})
+                if not out.converged:
+                    status, message = "failed", _failure(i, load_steps, lam, out, [])
+                    break
+                q = out.x
+                continue
             fused = None
             if "residual_jacobian" in caps:
                 def fused(x, m=m):
@@ -199,13 +210,7 @@ def solve_static(model: Model, load_steps: int = 10, *, t: float = 0.0, q0: Arra
             steps.append({"load_factor": lam, "iterations": out.iterations, "residual": out.residual_norm,
                           "converged": out.converged, "q": out.x if out.converged else q.copy()})
             if not out.converged:
-                status = "failed"
-                message = (f"load step {i} of {load_steps} (load factor {lam:g}) did not converge: "
-                           f"{out.message}; max|r| = {out.residual_norm:.3e}")
-                if singular or "singular" in out.message or "factorisation failed" in out.message:
-                    why = f" ({singular[0].message})" if singular else ""
-                    message += (f". The stiffness matrix is singular{why}: a static "
-                                "problem needs supports that remove every rigid-body motion.")
+                status, message = "failed", _failure(i, load_steps, lam, out, singular)
                 break
             q = out.x
             ev = m.step_event(t, q, z) if state else None
@@ -222,6 +227,17 @@ def solve_static(model: Model, load_steps: int = 10, *, t: float = 0.0, q0: Arra
     if any(s["converged"] for s in steps):
         _judge(result, m, t, check_stability, max_strain, len([s for s in steps if s["converged"]]), load_steps)
     return result
+
+
+def _failure(i, load_steps, lam, out, singular):
+    """The message of a load step that did not converge (``singular``: LAPACK's warnings during it)."""
+    message = (f"load step {i} of {load_steps} (load factor {lam:g}) did not converge: "
+               f"{out.message}; max|r| = {out.residual_norm:.3e}")
+    if singular or "singular" in out.message or "factorisation failed" in out.message:
+        why = f" ({singular[0].message})" if singular else ""
+        message += (f". The stiffness matrix is singular{why}: a static "
+                    "problem needs supports that remove every rigid-body motion.")
+    return message
 
 
 def _judge(result, m, t, check_stability, max_strain, done, load_steps):

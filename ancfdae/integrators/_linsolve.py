@@ -106,6 +106,21 @@ class _Banded:
         self.lub, self.piv, info = trf(ab.reshape((ldab, n), order="F"), kl, ku, overwrite_ab=1)
         self.singular = info > 0
         self._compiled = kl + ku <= COMPILED_SOLVE_MAX
+        if self._compiled:
+            self._trim()
+
+    def _trim(self):
+        """Drop the factor's leading rows that are zero in every column (``ku`` shrinks with them).
+
+        ``dgbtrf`` keeps ``kl`` rows for the fill of row interchanges; where the interchanges never
+        reach that far (a beam's Newton matrix: 3 of 22 rows at half bandwidth 7), the compiled
+        substitution would subtract ``0 * b[j]`` there, which changes no bit of a finite ``b``.
+        """
+        z = 0
+        while z < self.ku and not self.lub[z].any():
+            z += 1
+        if z:
+            self.lub, self.ku = np.asfortranarray(self.lub[z:]), self.ku - z
 
     def solve(self, rhs):
         if self._compiled:

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["band_solve", "pair_solve"]
+__all__ = ["band_solve", "pair_solve", "band_fill", "band_factor"]
 
 
 @njit(cache=True, error_model="numpy")   # a zero pivot gives inf/nan, as LAPACK does
@@ -56,3 +56,68 @@ def pair_solve(lub, kl, ku, piv, R, s0, s1, w0, w1, out):
     for i in range(n):
         out[i, 0] = 2.0 * (y[i] * w0).real
         out[i, 1] = 2.0 * (y[i] * w1).real
+
+
+# The factorisation as one compiled loop, for a Newton iteration that runs entirely compiled (the static
+# full Newton of :mod:`ancfdae.models.beam.static_numba`): from Python, LAPACK's ``dgbtrf`` stays the choice
+# (module :mod:`._linsolve`). Storage: ``ab`` of shape ``(n, 2 kl + ku + 1)`` in C order, i.e. LAPACK's
+# Fortran ``AB(ldab, n)`` with ``A[i, j]`` at ``ab[j, kl + ku + i - j]``, so ``ab.T`` is the factor that
+# :func:`band_solve` reads; the elimination is ``dgbtf2``'s (LAPACK's own choice below its block size 32),
+# which gives LAPACK's bits on beam matrices (``tests/integrators/test_linsolve.py``).
+@njit(cache=True)
+def band_fill(data, flat, ab):
+    """Zero ``ab`` and place the CSR ``data`` at the precomputed flat band positions ``flat``.
+
+    Positions may repeat (a non-canonical CSR pattern); repeated entries add.
+    """
+    ab[:] = 0.0
+    for k in range(data.size):
+        ab[flat[k]] += data[k]
+
+
+@njit(cache=True)
+def band_factor(ab, kl, ku, piv):
+    """In-place LU with partial pivoting of a band matrix in ``ab`` (layout: module docstring).
+
+    Returns the LAPACK ``info``: 0, or ``j + 1`` for the first exactly zero
+    pivot ``U[j, j]`` (the factorisation is completed; a solve then divides by zero).
+    """
+    n = ab.shape[0]
+    kv = kl + ku
+    info = 0
+    col = np.empty(kl + 1)
+    ju = 0   # last column touched by the row interchanges so far
+    for j in range(n):
+        km = min(kl, n - 1 - j)
+        # pivot: largest |A[j + i, j]|, i = 0..km (first one on ties, as idamax)
+        jp = 0
+        big = abs(ab[j, kv])
+        for i in range(1, km + 1):
+            v = abs(ab[j, kv + i])
+            if v > big:
+                big, jp = v, i
+        piv[j] = j + jp
+        if ab[j, kv + jp] == 0.0:
+            if info == 0:
+                info = j + 1
+            continue
+        ju = max(ju, min(j + ku + jp, n - 1))
+        if jp != 0:   # swap rows j and j + jp in columns j..ju
+            for c in range(j, ju + 1):
+                a = kv + j - c
+                tmp = ab[c, a + jp]
+                ab[c, a + jp] = ab[c, a]
+                ab[c, a] = tmp
+        if km > 0:
+            rp = 1.0 / ab[j, kv]
+            for i in range(1, km + 1):
+                ab[j, kv + i] *= rp
+                col[i] = ab[j, kv + i]   # the multipliers, apart: the update loop then vectorises
+            for c in range(j + 1, ju + 1):
+                a = kv + j - c
+                u = ab[c, a]
+                if u != 0.0:
+                    row = ab[c]
+                    for i in range(1, km + 1):
+                        row[a + i] -= col[i] * u
+    return info

@@ -121,3 +121,35 @@ def test_band_map_is_reused_for_a_copied_pattern_and_redone_for_another():
     other[[0, 1]] = other[[1, 0]]   # same row lengths (same indptr), other columns
     assert ls._band_map(A.indptr, other, 60) is not first
     assert ls._band_map(A.indptr, A.indices, 60)[:3] == first[:3]
+
+
+def test_trimmed_factor_solves_to_the_same_bits_as_the_full_one():
+    # Catches: a trim that drops a row with a nonzero entry, or ku not shrunk with the rows (the
+    # substitution then reads the wrong band row): the solve would differ from LAPACK's factors.
+    import scipy.linalg.lapack as lapack
+    from ancfdae.integrators._linsolve_numba import band_solve
+    n, kl, ku = 102, 7, 7
+    rng = np.random.default_rng(3)
+    A = _banded(n, kl, ku, seed=3) + 30.0 * np.eye(n)   # dominant diagonal: few interchanges, fill rows stay zero
+    lu = ls.factorize(sp.csr_matrix(A))
+    assert lu._compiled and lu.ku < ku and lu.lub.shape[0] == 2 * kl + ku + 1 - (ku - lu.ku)
+    ab = np.zeros((2 * kl + ku + 1, n))
+    for j in range(n):
+        for i in range(max(0, j - ku), min(n, j + kl + 1)):
+            ab[kl + ku + i - j, j] = A[i, j]
+    full, piv, info = lapack.dgbtrf(ab, kl, ku)
+    for _ in range(3):
+        b = rng.standard_normal(n)
+        x_full = b.copy()
+        band_solve(np.asfortranarray(full), kl, ku, piv, x_full)
+        assert np.array_equal(lu.solve(b), x_full)
+
+
+def test_factor_with_a_full_fill_row_is_not_trimmed():
+    # Catches: trimming rows that row interchanges filled (a pivot from below in the first column).
+    A = _banded(40, 3, 3, seed=4)
+    A[0, 0], A[3, 0] = 1e-6, 50.0
+    lu = ls.factorize(sp.csr_matrix(A))
+    assert lu.ku == 3 or lu.lub[0].any()
+    b = np.linspace(1.0, 2.0, 40)
+    assert np.abs(A @ lu.solve(b) - b).max() <= 1e-10 * np.linalg.cond(A)

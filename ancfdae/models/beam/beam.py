@@ -126,7 +126,7 @@ class Beam(MassForms):
         self._asm = Assembler(self.edofs, free_of_full, self.n_dof, element.n_node_dof)
         self.mass_is_constant = bool(element.mass_is_constant)
         self._M_data = self._asm.data(element.mass_matrix(self.geom))
-        self._M_csr = self._asm.csr(self._M_data)   # constant-mass product M a, built once
+        self._M_csr = self._asm.product_csr(self._M_data)   # constant-mass product M a, built once
         self._zero_data = np.zeros(self._asm.nnz)
         self.load_factor = 1.0
         self.loads = load_sequence(loads)   # kept for describe()
@@ -275,7 +275,7 @@ class Beam(MassForms):
     def _static_residual(self, a, f, fext, fused):
         """``f + M a - lambda f_ext`` (in place in ``f`` on the fused path: the same rounding)."""
         if fused:
-            _finish_residual()(f, self._M_data, self._asm.indptr, self._asm.indices,
+            _finish_residual()(f, self._M_csr.data, self._M_csr.indptr, self._M_csr.indices,
                             np.ascontiguousarray(a, dtype=float), float(self.load_factor),
                             np.ascontiguousarray(fext, dtype=float))
             return f

@@ -31,7 +31,7 @@ class CompiledResidual:
         The element's entry point (contract in :mod:`ancfdae.models.beam.iteration_numba`).
     arrays : tuple
         ``(q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices)``: the fused kernel's arrays
-        after ``q`` and the CSR mass data and pattern.
+        after ``q`` and the CSR mass for products (its own pattern, without stored zeros).
     element_args : tuple
         The element's own arguments, last in the call.
     external : callable
@@ -71,7 +71,8 @@ def compiled_residual(beam: "ancfdae.models.Beam") -> CompiledResidual | None:
     def external(t):
         return np.ascontiguousarray(loads.external(t, None, beam.geom, False)[0], dtype=float)
 
-    arrays = (beam._q_fixed, beam._gather, asm._vec_all, asm._slot_all, beam._M_data, asm.indptr, asm.indices)
+    m = beam._M_csr   # the mass without its stored zeros (Assembler.product_csr)
+    arrays = (beam._q_fixed, beam._gather, asm._vec_all, asm._slot_all, m.data, m.indptr, m.indices)
     steps = getattr(beam.element.kernels, "alpha_steps", None)
     dead = np.array([vec for _, vec in loads.dead], dtype=float).reshape(len(loads.dead), loads.n_dof)
     return CompiledResidual(fn, arrays, tuple(element_args), external, float(beam.load_factor),

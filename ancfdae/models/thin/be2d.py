@@ -7,7 +7,8 @@ Both formulations are written as an energy density in the two invariants of
 the axis at a quadrature point, ``g = r'.r'`` and ``c = (r' x r'').e_z``:
 ``|r'| = sqrt(g)`` and the material curvature ``K = c / g`` (Eq. 70). Since
 ``g`` and ``c`` are quadratic forms in the element coordinates, their
-Hessians are constant and are precomputed; the force is
+Hessians are constant (the NumPy reference stores them at its first use,
+:func:`reference_terms`; the compiled kernel forms them on the fly); the force is
 ``W_g dg + W_c dc`` and the tangent
 ``W_gg dg dg^T + W_gc (dg dc^T + dc dg^T) + W_cc dc dc^T + W_g d2g + W_c d2c``,
 exact, for all elements and points in a few ``einsum`` calls.
@@ -40,6 +41,33 @@ def _expand2(N: np.ndarray) -> np.ndarray:
 
 
 
+def reference_terms(geom: dict) -> tuple:
+    """``(dN, ddN, d2)``: the NumPy reference's own arrays, made at its first use and kept in ``geom``.
+
+    ``dN``, ``ddN`` (4, 1, n_el, n_pts): the shape-function derivatives points-last, and ``d2``
+    (n_el, 2 n_pts, 64): the constant Hessians of ``g = r'.r'`` and ``c = (r' x r'').e_z``,
+    ``d2g[k, a, l, b] = 2 N'_k N'_l delta_ab``, ``d2c[k, a, l, b] = N'_k N''_l P_ab + N''_k N'_l P_ba``
+    (``P_01 = 1``, ``P_10 = -1``), written block by block (no temporaries of its size). The compiled
+    kernel forms the Hessians on the fly, so a beam that never calls the reference does not store them
+    (7.2 GB at 10^6 elements).
+    """
+    terms = geom.get("_reference")
+    if terms is None:
+        dN, ddN = geom["dN_e"], geom["ddN_e"]                       # (n_el, n_pts, 4)
+        n_el, n_pts = dN.shape[:2]
+        d2 = np.zeros((n_el, 2, n_pts, 4, 2, 4, 2))
+        gg = 2.0 * (dN[:, :, :, None] * dN[:, :, None, :])
+        x, y = dN[:, :, :, None] * ddN[:, :, None, :], ddN[:, :, :, None] * dN[:, :, None, :]
+        for a in range(2):
+            d2[:, 0, :, :, a, :, a] = gg
+        d2[:, 1, :, :, 0, :, 1] = x - y
+        d2[:, 1, :, :, 1, :, 0] = y - x
+        terms = geom["_reference"] = (np.ascontiguousarray(dN.transpose(2, 0, 1))[:, None],
+                                      np.ascontiguousarray(ddN.transpose(2, 0, 1))[:, None],
+                                      d2.reshape(n_el, 2 * n_pts, 64))
+    return terms
+
+
 def invariants(geom: dict, q: np.ndarray, order: int = 1) -> tuple:
     """``g = r'.r'`` and ``c = (r' x r'').e_z`` at every point, shape (n_el, n_pts); for ``order`` 1 also
     their gradients ``dg``, ``dc`` in the element coordinates, shape (4, 2, n_el, n_pts)."""
@@ -50,7 +78,7 @@ def invariants(geom: dict, q: np.ndarray, order: int = 1) -> tuple:
     c = r1[0] * r2[1] - r1[1] * r2[0]
     if order == 0:
         return g, c
-    dN, ddN = geom["dN"], geom["ddN"]
+    dN, ddN = reference_terms(geom)[:2]
     dg = dN * (2.0 * r1)
     # dc = Sx^T P r'' + Sxx^T P^T r', with P r'' = (r''_y, -r''_x), P^T r' = (-r'_y, r'_x)
     r2[0] *= -1.0
@@ -146,7 +174,7 @@ class BE2DReference(Kernel):
         A = np.concatenate([dg, dc], axis=-1).reshape(8, n_el, 2 * n_pts).transpose(1, 0, 2)
         B = np.concatenate([Bg, Bc], axis=-1).reshape(8, n_el, 2 * n_pts).transpose(1, 2, 0)
         first = np.stack([wg, wc], axis=1).reshape(n_el, 1, 2 * n_pts)
-        K = A @ B + (first @ geom["d2"]).reshape(n_el, 8, 8)
+        K = A @ B + (first @ reference_terms(geom)[2]).reshape(n_el, 8, 8)
         return f, K
 
 
@@ -245,20 +273,7 @@ class BE2D(Element):
         n_el, n_pts = dN.shape[:2]
         geom = {"L": lengths, "w": w[None, :] * lengths[:, None] / 2.0,
                 "dN_e": dN, "ddN_e": ddN,                                   # (n_el, n_pts, 4): for r', r''
-                "dN": np.ascontiguousarray(dN.transpose(2, 0, 1))[:, None],  # (4, 1, n_el, n_pts)
-                "ddN": np.ascontiguousarray(ddN.transpose(2, 0, 1))[:, None],
                 "n_a": sa.size}
-        # Constant Hessians of g = r'.r' and c = (r' x r'').e_z, stacked as (n_el, 2*n_pts, 64):
-        # d2g[k, a, l, b] = 2 N'_k N'_l delta_ab, d2c[k, a, l, b] = N'_k N''_l P_ab + N''_k N'_l P_ba
-        # (P_01 = 1, P_10 = -1), written block by block into one array (no temporaries of its size).
-        d2 = np.zeros((n_el, 2, n_pts, 4, 2, 4, 2))
-        gg = 2.0 * (dN[:, :, :, None] * dN[:, :, None, :])
-        x, y = dN[:, :, :, None] * ddN[:, :, None, :], ddN[:, :, :, None] * dN[:, :, None, :]
-        for a in range(2):
-            d2[:, 0, :, :, a, :, a] = gg
-        d2[:, 1, :, :, 0, :, 1] = x - y
-        d2[:, 1, :, :, 1, :, 0] = y - x
-        geom["d2"] = d2.reshape(n_el, 2 * n_pts, 64)
         g, c = invariants(geom, q_ref, order=0)
         geom["eps_ref"] = np.sqrt(g) - 1.0
         geom["K_ref"] = c / g

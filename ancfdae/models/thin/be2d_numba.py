@@ -16,14 +16,14 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..beam.assembly_numba import gather_elements, scatter
 from ...integrators._affine import affine3
 from ..beam.iteration_numba import alpha_finish, alpha_update, carry_on
 from ...integrators._alpha_steps_numba import alpha_steps
+from ..beam.static_numba import static_newton
 from ..element import Kernel
 
-__all__ = ["BE2DCompiled", "be2d_forces", "be2d_fused", "be2d_alpha_iterations", "be2d_alpha_steps", "STRUCTURAL",
-           "CONTINUUM"]
+__all__ = ["BE2DCompiled", "be2d_forces", "be2d_fused", "be2d_alpha_iterations", "be2d_alpha_steps",
+           "be2d_static_newton", "STRUCTURAL", "CONTINUUM"]
 
 STRUCTURAL, CONTINUUM = 0, 1
 
@@ -60,6 +60,100 @@ def _densities_bending(form, g, c, K_ref, E, I, I4):
             E * (I * phi + 6 * I4 * c2 * psi))
 
 
+@njit(cache=True, inline="always", fastmath={"contract"})
+def _element(e, q0, q1, q2, q3, q4, q5, q6, q7, dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4, tangent,
+             Ku, dg, dc):
+    """Element ``e``'s forces ``dU/dq_e`` as eight scalars (x, y per Hermite function) and, if ``tangent``,
+    the upper triangle of its stiffness in ``Ku`` (8, 8).
+
+    The forces are accumulated in scalars, ``f_x,k = a_k u_x + b_k v_x`` with ``a_k, b_k`` the
+    shape-function derivatives and ``u, v`` the point's coefficients (``dg = 2 a r'``,
+    ``dc = (a r''_y - b r'_y, -a r''_x + b r'_x)``, the same sums regrouped): no per-point arrays are
+    written or read back, which LLVM cannot keep in registers (numba gives it no aliasing facts).
+    The tangent is ``W_gg dg dg^T + W_gc (dg dc^T + dc dg^T) + W_cc dc dc^T + W_g d2g + W_c d2c``
+    with the constant Hessians d2g, d2c formed on the fly; it is symmetric, so its upper triangle
+    is accumulated (mirrored by the caller).
+    """
+    f0 = f1 = f2 = f3 = f4 = f5 = f6 = f7 = 0.0
+    if tangent:
+        Ku[:] = 0.0
+    for p in range(w.shape[1]):
+        a0, a1, a2, a3 = dN[e, p, 0], dN[e, p, 1], dN[e, p, 2], dN[e, p, 3]
+        r1x = a0 * q0 + a1 * q2 + a2 * q4 + a3 * q6
+        r1y = a0 * q1 + a1 * q3 + a2 * q5 + a3 * q7
+        g = r1x * r1x + r1y * r1y
+        wp = w[e, p]
+        axial = p < n_a
+        if axial:   # W depends on g alone here: r'' and dc do not enter
+            Wg, Wgg = _densities_axial(form, g, eps_ref[e, p], EA)
+            Wc = Wgc = Wcc = 0.0
+            wg = wp * Wg
+            ux, uy = 2.0 * wg * r1x, 2.0 * wg * r1y
+            f0 += a0 * ux
+            f1 += a0 * uy
+            f2 += a1 * ux
+            f3 += a1 * uy
+            f4 += a2 * ux
+            f5 += a2 * uy
+            f6 += a3 * ux
+            f7 += a3 * uy
+            r2x = r2y = 0.0
+        else:
+            b0, b1, b2, b3 = ddN[e, p, 0], ddN[e, p, 1], ddN[e, p, 2], ddN[e, p, 3]
+            r2x = b0 * q0 + b1 * q2 + b2 * q4 + b3 * q6
+            r2y = b0 * q1 + b1 * q3 + b2 * q5 + b3 * q7
+            c = r1x * r2y - r1y * r2x
+            Wg, Wc, Wgg, Wgc, Wcc = _densities_bending(form, g, c, K_ref[e, p], E, I, I4)
+            wg, wc = wp * Wg, wp * Wc
+            ux, uy = 2.0 * wg * r1x + wc * r2y, 2.0 * wg * r1y - wc * r2x
+            vx, vy = -wc * r1y, wc * r1x
+            f0 += a0 * ux + b0 * vx
+            f1 += a0 * uy + b0 * vy
+            f2 += a1 * ux + b1 * vx
+            f3 += a1 * uy + b1 * vy
+            f4 += a2 * ux + b2 * vx
+            f5 += a2 * uy + b2 * vy
+            f6 += a3 * ux + b3 * vx
+            f7 += a3 * uy + b3 * vy
+        if not tangent:
+            continue
+        for k in range(4):
+            a = dN[e, p, k]
+            dg[2 * k] = 2.0 * a * r1x
+            dg[2 * k + 1] = 2.0 * a * r1y
+            if not axial:   # dc = Sx^T P r'' + Sxx^T P^T r'
+                b = ddN[e, p, k]
+                dc[2 * k] = a * r2y - b * r1y
+                dc[2 * k + 1] = -a * r2x + b * r1x
+        wgg, wgc, wcc = wp * Wgg, wp * Wgc, wp * Wcc
+        if axial:
+            for i in range(8):
+                bg = dg[i] * wgg
+                for j in range(i, 8):
+                    Ku[i, j] += bg * dg[j]
+        else:
+            for i in range(8):
+                bg = dg[i] * wgg + dc[i] * wgc
+                bc = dg[i] * wgc + dc[i] * wcc
+                for j in range(i, 8):
+                    Ku[i, j] += bg * dg[j] + bc * dc[j]
+        # Constant Hessians: d2g = 2 dN_k dN_l delta_ab, d2c = dN_k ddN_l P_ab + ddN_k dN_l P_ba,
+        # P = [[0, 1], [-1, 0]]; upper triangle only (rows 2k, 2k+1 <= columns 2m, 2m+1).
+        for k in range(4):
+            ak, bk = dN[e, p, k], ddN[e, p, k]
+            for m in range(k, 4):
+                am, bm = dN[e, p, m], ddN[e, p, m]
+                hg = 2.0 * wg * ak * am
+                Ku[2 * k, 2 * m] += hg
+                Ku[2 * k + 1, 2 * m + 1] += hg
+                if not axial:
+                    hc = wc * (ak * bm - bk * am)
+                    Ku[2 * k, 2 * m + 1] += hc
+                    if m > k:
+                        Ku[2 * k + 1, 2 * m] -= hc
+    return f0, f1, f2, f3, f4, f5, f6, f7
+
+
 @njit(cache=True, fastmath={"contract"})
 def be2d_forces(q, dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4, tangent):
     """Element forces ``dU/dq_e`` (n_el, 8) and, if ``tangent``, stiffness (n_el, 8, 8).
@@ -67,84 +161,16 @@ def be2d_forces(q, dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4, tangent)
     ``q`` (n_el, 8) element coordinates in the order (x, y) per Hermite
     function; ``dN``, ``ddN`` (n_el, n_pts, 4) shape-function derivatives at
     the axial points (the first ``n_a``) then the bending points; ``w``
-    (n_el, n_pts) weights times the Jacobian ``L/2``. The tangent is
-    ``W_gg dg dg^T + W_gc (dg dc^T + dc dg^T) + W_cc dc dc^T + W_g d2g + W_c d2c``
-    with the constant Hessians d2g, d2c formed on the fly; it is symmetric, so
-    its upper triangle is accumulated and mirrored.
+    (n_el, n_pts) weights times the Jacobian ``L/2``. One element: :func:`_element`.
     """
-    n_el, n_pts = w.shape
-    f = np.zeros((n_el, 8))
+    n_el = w.shape[0]
+    f = np.empty((n_el, 8))
     K = np.empty((n_el, 8, 8) if tangent else (0, 8, 8))
-    Ku = np.empty((8, 8))   # upper triangle of one element's tangent (it is symmetric)
-    dg = np.empty(8)
-    dc = np.empty(8)
+    Ku, dg, dc = np.empty((8, 8)), np.empty(8), np.empty(8)
     for e in range(n_el):
-        if tangent:
-            Ku[:] = 0.0
-        for p in range(n_pts):
-            # r' (and r'' at a bending point) at the point
-            axial = p < n_a
-            r1x = r1y = r2x = r2y = 0.0
-            for k in range(4):
-                r1x += dN[e, p, k] * q[e, 2 * k]
-                r1y += dN[e, p, k] * q[e, 2 * k + 1]
-            g = r1x * r1x + r1y * r1y
-            wp = w[e, p]
-            if axial:
-                Wg, Wgg = _densities_axial(form, g, eps_ref[e, p], EA)
-                Wc = Wgc = Wcc = 0.0
-                for k in range(4):
-                    a = dN[e, p, k]
-                    dg[2 * k] = 2.0 * a * r1x
-                    dg[2 * k + 1] = 2.0 * a * r1y
-            else:
-                for k in range(4):
-                    r2x += ddN[e, p, k] * q[e, 2 * k]
-                    r2y += ddN[e, p, k] * q[e, 2 * k + 1]
-                c = r1x * r2y - r1y * r2x
-                Wg, Wc, Wgg, Wgc, Wcc = _densities_bending(form, g, c, K_ref[e, p], E, I, I4)
-                for k in range(4):
-                    a, b = dN[e, p, k], ddN[e, p, k]
-                    dg[2 * k] = 2.0 * a * r1x
-                    dg[2 * k + 1] = 2.0 * a * r1y
-                    # dc = Sx^T P r'' + Sxx^T P^T r'
-                    dc[2 * k] = a * r2y - b * r1y
-                    dc[2 * k + 1] = -a * r2x + b * r1x
-            wg, wc = wp * Wg, wp * Wc
-            if axial:   # W depends on g alone here: r'' and dc do not enter
-                for i in range(8):
-                    f[e, i] += dg[i] * wg
-            else:
-                for i in range(8):
-                    f[e, i] += dg[i] * wg + dc[i] * wc
-            if not tangent:
-                continue
-            wgg, wgc, wcc = wp * Wgg, wp * Wgc, wp * Wcc
-            if axial:
-                for i in range(8):
-                    bg = dg[i] * wgg
-                    for j in range(i, 8):
-                        Ku[i, j] += bg * dg[j]
-            else:
-                for i in range(8):
-                    bg = dg[i] * wgg + dc[i] * wgc
-                    bc = dg[i] * wgc + dc[i] * wcc
-                    for j in range(i, 8):
-                        Ku[i, j] += bg * dg[j] + bc * dc[j]
-            # Constant Hessians: d2g = 2 dN_k dN_l delta_ab, d2c = dN_k ddN_l P_ab + ddN_k dN_l P_ba,
-            # P = [[0, 1], [-1, 0]]; upper triangle only (rows 2k, 2k+1 <= columns 2m, 2m+1).
-            for k in range(4):
-                ak, bk = dN[e, p, k], ddN[e, p, k]
-                for m in range(k, 4):
-                    am, bm = dN[e, p, m], ddN[e, p, m]
-                    hg = 2.0 * wg * ak * am
-                    Ku[2 * k, 2 * m] += hg
-                    Ku[2 * k + 1, 2 * m + 1] += hg
-                    if not axial:
-                        hc = wc * (ak * bm - bk * am)
-                        Ku[2 * k, 2 * m + 1] += hc
-                        if m > k:
-                            Ku[2 * k + 1, 2 * m] -= hc
+        f[e, 0], f[e, 1], f[e, 2], f[e, 3], f[e, 4], f[e, 5], f[e, 6], f[e, 7] = _element(
+            e, q[e, 0], q[e, 1], q[e, 2], q[e, 3], q[e, 4], q[e, 5], q[e, 6], q[e, 7],
+            dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4, tangent, Ku, dg, dc)
         if tangent:
             for i in range(8):
                 for j in range(i, 8):
@@ -153,20 +179,45 @@ def be2d_forces(q, dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4, tangent)
     return f, K
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath={"contract"})
 def be2d_fused(q, q_fixed, gather, vec_slot, mat_slot, tangent, r, kdata,
                dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4):
     """Gather, kernel and scatter in one call (the fused assembly of :mod:`ancfdae.models.beam.assembly_numba`).
 
     ``r`` (length ``n_dof + 1``) receives the assembled ``dU/dq`` and, if
     ``tangent``, ``kdata`` (length ``nnz + 1``) the CSR data of its tangent;
-    the last entry of each collects the fixed coordinates' share.
+    the last entry of each collects the fixed coordinates' share. Element by element, with no
+    element arrays in between: each element's coordinates are read through ``gather`` and its
+    forces (and tangent) added at their slots in element order, the additions of
+    :func:`~ancfdae.models.beam.assembly_numba.scatter` in the same order (the same bits as
+    :func:`be2d_forces` gathered and scattered).
     """
-    qe = gather_elements(q, q_fixed, gather)
-    f, K = be2d_forces(qe, dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4, tangent)
-    scatter(f, vec_slot, r)
+    nq = q.size
+    r[:] = 0.0
     if tangent:
-        scatter(K, mat_slot, kdata)
+        kdata[:] = 0.0
+    Ku, dg, dc = np.empty((8, 8)), np.empty(8), np.empty(8)
+    qe = np.empty(8)
+    for e in range(w.shape[0]):
+        for k in range(8):
+            g = gather[e, k]
+            qe[k] = q[g] if g < nq else q_fixed[g - nq]
+        fe = _element(e, qe[0], qe[1], qe[2], qe[3], qe[4], qe[5], qe[6], qe[7],
+                      dN, ddN, w, eps_ref, K_ref, n_a, form, EA, E, I, I4, tangent, Ku, dg, dc)
+        b = 8 * e
+        r[vec_slot[b]] += fe[0]
+        r[vec_slot[b + 1]] += fe[1]
+        r[vec_slot[b + 2]] += fe[2]
+        r[vec_slot[b + 3]] += fe[3]
+        r[vec_slot[b + 4]] += fe[4]
+        r[vec_slot[b + 5]] += fe[5]
+        r[vec_slot[b + 6]] += fe[6]
+        r[vec_slot[b + 7]] += fe[7]
+        if tangent:
+            b = 64 * e
+            for i in range(8):
+                for j in range(8):
+                    kdata[mat_slot[b + 8 * i + j]] += Ku[i, j] if j >= i else Ku[j, i]
 
 
 @njit(cache=True)
@@ -197,6 +248,12 @@ def be2d_alpha_iterations(x, r, err, max_k, contraction, threshold, lub, kl, ku,
 def be2d_alpha_steps(S, P, fpar, ipar, out, lub, piv, gravity, dead, scales, arrays, element_args):
     """Newmark-family steps in one call (contract in :mod:`ancfdae.integrators._alpha_steps_numba`)."""
     alpha_steps(be2d_alpha_iterations, S, P, fpar, ipar, out, lub, piv, gravity, dead, scales, arrays, element_args)
+
+
+@njit(cache=True)
+def be2d_static_newton(x, r, f_ext, fpar, ipar, flat, ab, piv, kdata, rbuf, arrays, element_args):
+    """A load step's static full Newton in one call (contract in :mod:`ancfdae.models.beam.static_numba`)."""
+    return static_newton(be2d_fused, x, r, f_ext, fpar, ipar, flat, ab, piv, kdata, rbuf, arrays, element_args)
 
 
 class BE2DCompiled(Kernel):
@@ -233,3 +290,7 @@ class BE2DCompiled(Kernel):
     def alpha_steps(self, geom: dict) -> tuple:
         """``(be2d_alpha_steps, args)``: compiled whole steps (:mod:`ancfdae.integrators._alpha_steps_numba`)."""
         return be2d_alpha_steps, self._args(geom)
+
+    def static_newton(self, geom: dict) -> tuple:
+        """``(be2d_static_newton, args)``: a load step's static full Newton (:mod:`ancfdae.models.beam.static_numba`)."""
+        return be2d_static_newton, self._args(geom)

@@ -104,3 +104,16 @@ def test_sq_fused_equals_numpy_assembly(name, formulation):
     Q = q[:, None] + 0.01 * rng.standard_normal((n, 2))
     R1, R0 = _both(beam, ref, lambda b: b.residual_stages(np.array([0.1, 0.3]), Q, Q, Q))
     assert np.array_equal(R1, R0)
+
+
+def test_mass_product_matrix_drops_stored_zeros_and_keeps_the_bits():
+    # Catches: a product mass that lost a nonzero entry or reordered a row's sum (the residual's M a
+    # would then differ from the full-pattern product), or one that still carries the zeros.
+    beam = _beam("structural")
+    full = beam._asm.csr(beam._M_data)
+    pruned = beam._M_csr
+    assert pruned.nnz < full.nnz and np.all(pruned.data != 0.0)
+    assert pruned.indices is not beam._asm.indices and full.indices is beam._asm.indices
+    a = np.random.default_rng(7).standard_normal(beam.n_dof)
+    assert np.array_equal(pruned @ a, full @ a)
+    assert np.array_equal(pruned.toarray(), full.toarray())
