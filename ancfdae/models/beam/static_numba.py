@@ -5,8 +5,9 @@ Run from Python, an iteration of a 16-element BE2D cantilever (B1) costs some 10
 the copy into band storage, LAPACK's factorisation, three CSR wrappers -- where the arithmetic is a few
 microseconds. An element that offers a static entry point (``Kernel.static_newton``; BE2D:
 :func:`ancfdae.models.thin.be2d_numba.be2d_static_newton`, a one-line call of :func:`static_newton` with its
-fused kernel, for the on-disk cache as in :mod:`.iteration_numba`) runs the whole solve of a load step in
-one call::
+fused kernel, for the on-disk cache as in :mod:`.iteration_numba`; numba keys that cache on the element's
+file, so after editing this module delete the element's ``*.nbi``/``*.nbc`` files) runs the whole solve of a
+load step in one call::
 
     static_newton(x, r, f_ext, fpar, ipar, flat, ab, piv, kdata, rbuf, arrays, element_args)
         -> (status, iterations, residual_evals, err, rate, threshold)
