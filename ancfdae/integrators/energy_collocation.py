@@ -60,6 +60,7 @@ import scipy.sparse.linalg as spla
 from ancfdae import _validate as validate
 from ancfdae._scale import ENERGY_ROUNDOFF
 from ancfdae.integrators._alpha_index3 import mass_scale
+from ancfdae.integrators._energy_correction import VelocityCorrection, energy_defect, keep_residual, round_off_test
 from ancfdae.integrators._hbvm_coefficients import hbvm_coefficients
 from ancfdae.integrators._hbvm_constrained import constrained_hbvm_step
 from ancfdae.integrators._linsolve import StageMatrix
@@ -70,7 +71,8 @@ from ancfdae.integrators.newton_stepper import NewtonStepper
 from ancfdae.integrators.protocol import Quadrature, StepOutcome
 from ancfdae.problem import JacobianBlocks, Model, capabilities
 
-__all__ = ["EnergyCollocation", "SMOOTH_SILENT_STAGES", "ITERATION_MATRICES"]
+__all__ = ["EnergyCollocation", "SMOOTH_SILENT_STAGES", "ITERATION_MATRICES", "ENERGY_CORRECTIONS",
+           "CORRECTED_NEWTON"]
 
 #: Silent stages for a potential that is not a polynomial (chosen by measurement, see docs/energy_momentum.md:
 #: one element, 1000 steps of 10 ms, energy drift SQ3D structural 3.6e-11 / 6.6e-14 / 3.8e-14 at k = 4 / 5 / 6,
@@ -78,10 +80,10 @@ __all__ = ["EnergyCollocation", "SMOOTH_SILENT_STAGES", "ITERATION_MATRICES"]
 #: at k = 5, 9.0e-14 at k = 6).
 SMOOTH_SILENT_STAGES = 5
 ITERATION_MATRICES = ("split", "exact")
+ENERGY_CORRECTIONS = ("velocity", "newton")
+#: Newton of ``energy_correction="velocity"``: the chapter's relative tolerance, as Lobatto IIIA-3.
+CORRECTED_NEWTON = NewtonOptions(tol=1e-8)
 _S = 2          # fundamental stages: order 4
-_EPS = float(np.finfo(float).eps)
-#: Newton accepts a step when the energy identity's defect is below this times eps times its terms' size.
-ENERGY_DEFECT = 1.0
 
 
 class _SplitMatrix(StageMatrix):
@@ -152,13 +154,26 @@ class EnergyCollocation(NewtonStepper):
     FLOOR_UPDATE = "replace"     # as energy-momentum: the energy identity needs the latest floor
 
     def __init__(self, model: Model, h: float, *, silent_stages: int | str = "auto",
-                 iteration_matrix: str = "split", newton: NewtonOptions | dict | None = None) -> None:
+                 iteration_matrix: str = "split", energy_correction: str = "auto",
+                 newton: NewtonOptions | dict | None = None) -> None:
         require_potential_model(model, self.name)
         if "constraints" in capabilities(model) and getattr(model, "constraint_degree", None) not in (1, 2):
             raise ValueError("`model` constraints must be at most quadratic in q (constraint_degree 1 or 2) for "
                              f"method {self.name!r}, whose 3-point exactness of d g(sigma)/dc keeps the joints "
                              f"workless; got constraint_degree={getattr(model, 'constraint_degree', None)!r}.")
-        super().__init__(model, h, newton=DEFAULT_NEWTON if newton is None else newton)
+        correction = validate.choice("energy_correction", energy_correction, ("auto",) + ENERGY_CORRECTIONS)
+        constrained = "constraints" in capabilities(model)
+        if correction == "auto":
+            correction = "newton" if constrained else "velocity"
+        elif correction == "velocity" and constrained:
+            raise ValueError("`energy_correction` 'velocity' cannot keep the constraints (it changes v1 alone); "
+                             "use 'newton' or 'auto' for a model with the 'constraints' capability.")
+        if newton is None:
+            newton = CORRECTED_NEWTON if correction == "velocity" else DEFAULT_NEWTON
+        super().__init__(model, h, newton=newton)
+        self.energy_correction = correction
+        if correction == "velocity":      # Newton stops at a tolerance, as Lobatto IIIA-3: its floor and update
+            self.FLOOR_ROUNDOFF, self.FLOOR_UPDATE = NewtonStepper.FLOOR_ROUNDOFF, NewtonStepper.FLOOR_UPDATE
         degree = getattr(model, "potential_degree", None)
         if isinstance(silent_stages, str) and silent_stages == "auto":
             k = max(_S, int(degree)) if degree is not None else SMOOTH_SILENT_STAGES
@@ -176,7 +191,8 @@ class EnergyCollocation(NewtonStepper):
     def options(self) -> dict:
         """The options as a JSON-able dict: ``h``, the Newton options, ``silent_stages``, ``iteration_matrix``."""
         o = super().options()
-        o.update(silent_stages=self.silent_stages, iteration_matrix=self.iteration_matrix)
+        o.update(silent_stages=self.silent_stages, iteration_matrix=self.iteration_matrix,
+                 energy_correction=self.energy_correction)
         return o
 
     def _setup(self):
@@ -198,6 +214,7 @@ class EnergyCollocation(NewtonStepper):
         z = np.zeros(self.n_dof)
         self._Mcsr = sp.csr_matrix(m.jacobian(self.t, self.q, z, z).M)   # the mass on the stiffness' pattern
         self._prev = None          # (h, Y) of the last step: the predictor
+        self._correct = VelocityCorrection(m, self._M)
 
     def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model) -> None:
         """Carry on from a state a model event changed (the predictor is dropped, the model rebound)."""
@@ -308,22 +325,26 @@ class EnergyCollocation(NewtonStepper):
         co, n, model = self._co, self.n_dof, self.model
         q0, v0 = self.q, self.v
         split = [self.iteration_matrix == "split" and self.newton.options.jacobian == "modified"]
-        residual, jacobian = self.stage_equations(t0, h, split)
-        guess = self._predict(h)
-        accept = self._energy_test(h)
-        out = self._solve(residual, jacobian, guess.ravel(), accept=accept)
-        if not out.converged and split[0]:
-            # the one-stiffness matrix can be too crude where the nodes differ much: retry with the exact one
-            split[0] = False
-            self.newton.invalidate()
-            out = self._solve(residual, jacobian, guess.ravel(), accept=accept)
-            self.newton.invalidate()       # the next step starts again from the split matrix
+        guess = self._predict(h).ravel()
+        out, r = self._solve_full(t0, h, split, guess)
         if not out.converged:
             return StepOutcome.failure(f"Newton: {out.message}")
         Y = out.x.reshape(n, _S)
         t1 = t0 + h
         q1 = q0 + (h * v0 + Y @ co.q_end)
         v1 = v0 + Y[:, 0] / h
+        if r is not None:
+            R = r.reshape(n, _S)
+            v1c = self._correct(h, v1, R[:, 0], energy_defect(Y, R, co.X, h * v0))
+            if v1c is None:     # a body near rest cannot carry the defect in its velocity: iterate to round-off
+                residual, jacobian = self.stage_equations(t0, h, split)
+                out = self._solve(residual, jacobian, out.x, accept=round_off_test(self._M, co.X, h, v0))
+                if not out.converged:
+                    return StepOutcome.failure(f"Newton: {out.message}")
+                Y = out.x.reshape(n, _S)
+                q1 = q0 + (h * v0 + Y @ co.q_end)
+                v1c = v0 + Y[:, 0] / h
+            v1 = v1c
         # The acceleration at t1 (interpolation, the next step's first guess): M a1 = -r(t1, q1, v1, 0).
         a1 = self._Mlu.solve(-np.asarray(model.residual(t1, q1, v1, np.zeros_like(q1)), dtype=float))
         if not np.all(np.isfinite(a1)):
@@ -336,28 +357,23 @@ class EnergyCollocation(NewtonStepper):
             quad = Quadrature(t=ts, q=Q.T, v=(v0[:, None] + (Y @ ld.Wd.T) / h).T, w=h * ld.b)
         return StepOutcome(ok=True, t=t1, q=q1, v=v1, a=a1, quadrature=quad)
 
-    def _energy_test(self, h):
-        """Newton's test after the residual's: the step's energy identity holds to round-off.
-
-        With the residual ``R_i`` left by Newton, ``T1 - T0 + P1 - P0 - W = sum_i V_i . R_i`` exactly, with
-        ``V = [h v0, 0] + Y X^T`` the Legendre coefficients of ``h sigma'`` (the identity of the module
-        docstring with ``R`` kept). A residual at its round-off floor is not enough: it leaves ``R``
-        biased along the step, and the defect piles up (one SQ3D element, 2000 steps of 10 ms: 9.1e-13
-        of the energy with the floor alone, 3.1e-14 with this test). Accepted when ``|sum V . R|`` is
-        below ``ENERGY_DEFECT * eps`` times the sum of the terms' magnitudes ``|V| (|A| + |R - A|)``,
-        ``A = M Y / h^2``; Newton also stops when its correction no longer halves (round-off reached).
-        """
-        n, X, M, hv, ih2 = self.n_dof, self._co.X, self._M, h * self.v, 1.0 / (h * h)
-
-        def accept(x, r):
-            Y, R = x.reshape(n, _S), r.reshape(n, _S)
-            V = Y @ X.T
-            V[:, 0] += hv
-            A = ih2 * (M @ Y)
-            scale = float(np.sum(np.abs(V) * (np.abs(A) + np.abs(R - A))))
-            return abs(float(np.sum(V * R))) / (ENERGY_DEFECT * _EPS * scale + 1e-300)
-
-        return accept
+    def _solve_full(self, t0, h, split, guess):
+        """Newton on the full stage residual: ``(outcome, residual at outcome.x)`` for the velocity correction,
+        ``(outcome, None)`` with ``energy_correction="newton"`` (Newton on to the energy's round-off)."""
+        residual, jacobian = self.stage_equations(t0, h, split)
+        last = {}
+        velocity = self.energy_correction == "velocity"
+        accept = keep_residual(last) if velocity else round_off_test(self._M, self._co.X, h, self.v)
+        out = self._solve(residual, jacobian, guess, accept=accept)
+        if not out.converged and split[0]:
+            # the one-stiffness matrix can be too crude where the nodes differ much: retry with the exact one
+            split[0] = False
+            self.newton.invalidate()
+            out = self._solve(residual, jacobian, guess, accept=accept)
+            self.newton.invalidate()       # the next step starts again from the split matrix
+        if not (out.converged and velocity):
+            return out, None
+        return out, (last["r"] if last.get("x") is out.x else residual(out.x))
 
     def _predict(self, h):
         """The previous step's acceleration polynomial continued (same ``h``), else ``Y = (h^2 a, 0)``."""
@@ -366,3 +382,4 @@ class EnergyCollocation(NewtonStepper):
         Y = np.zeros((self.n_dof, _S))
         Y[:, 0] = (h * h) * self.a
         return Y
+
