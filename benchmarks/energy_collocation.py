@@ -154,7 +154,7 @@ def work_precision(a):
     ref = run_one(a.problem, a.ref_method, h_ref, t_end, a.out)
     if not ref["ok"]:
         raise SystemExit(f"reference failed: {ref['message']}")
-    hs = sorted({h for v in sweep.values() for h in v}, reverse=True)
+    hs = sorted({h for v in sweep.values() for h in v if not a.hs or h in a.hs}, reverse=True)
     rows = []
     for h in hs:                                  # interleaved: every method at one step, then the next step
         for m, steps in sweep.items():
@@ -241,6 +241,7 @@ def main(argv=None):
                     help="long: k (default 'auto')")
     ap.add_argument("--cases", nargs="+", default=None, help="long: only these (e.g. SQ3D SQ3D-continuum)")
     ap.add_argument("--h-ref", type=float, default=None, help="step of the reference run (default: a quarter of the finest)")
+    ap.add_argument("--hs", type=float, nargs="+", default=None, help="wp: only these steps of the sweep")
     ap.add_argument("--ref-method", default="energy-collocation", help="wp: the reference run's method label")
     ap.add_argument("--out", type=Path, default=Path("out/energy_collocation"))
     a = ap.parse_args(argv)

@@ -53,7 +53,8 @@ class VelocityCorrection:
         self._M = M
         self._T = T
         self._MT = np.asarray(M @ T) if T.shape[1] else T
-        self._TMT = T.T @ self._MT if T.shape[1] else np.zeros((0, 0))
+        # (T^T M T)^-1, the translations' mass (d x d): every product below is with it or the dense M T
+        self._TMT_inv = np.linalg.inv(T.T @ self._MT) if T.shape[1] else np.zeros((0, 0))
 
     def __call__(self, h: float, v1: np.ndarray, R0: np.ndarray, defect: float) -> np.ndarray | None:
         """The corrected ``v1``, or None when the scaling cannot carry ``defect`` (:data:`MAX_SCALING`).
@@ -68,18 +69,26 @@ class VelocityCorrection:
             The stage residual's first Legendre row at that iterate.
         defect : float
             ``D = sum_i V_i . R_i`` at that iterate.
+
+        Notes
+        -----
+        One sparse product ``M v1``; the rest are products with the ``d`` translations (``M T`` dense).
         """
-        M, T, MT = self._M, self._T, self._MT
-        target = 0.5 * float(v1 @ (M @ v1)) - defect
+        T, MT, inv = self._T, self._MT, self._TMT_inv
+        Mv = self._M @ v1
+        target = 0.5 * float(v1 @ Mv) - defect
         if T.shape[1]:
-            v1 = v1 + T @ np.linalg.solve(self._TMT, -h * (T.T @ R0))
-            c = np.linalg.solve(self._TMT, MT.T @ v1)
+            dc = inv @ (-h * (T.T @ R0))            # the momentum's translation velocity
+            v1 = v1 + T @ dc
+            Mv = Mv + MT @ dc
+            p = T.T @ Mv                            # the momentum T^T M v1
+            c = inv @ p
             vt = T @ c
-            w = v1 - vt
-            kin_t = 0.5 * float(vt @ (M @ vt))
+            kin_t = 0.5 * float(c @ p)
         else:
-            vt, w, kin_t = 0.0, v1, 0.0
-        kin_w = 0.5 * float(w @ (M @ w))
+            vt, kin_t = 0.0, 0.0
+        kin_w = 0.5 * float(v1 @ Mv) - kin_t       # w = v1 - vt is M-orthogonal to vt
+        w = v1 - vt
         if not kin_w > 0.0:
             return None if defect != 0.0 else v1
         delta = (target - kin_t - kin_w) / kin_w        # (1 + alpha)^2 = 1 + delta
