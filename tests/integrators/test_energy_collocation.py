@@ -14,6 +14,7 @@ from ancfdae.integrators._hbvm_constrained import constrained_hbvm_equations
 from ancfdae.integrators._hbvm_coefficients import hbvm_coefficients, legendre01
 from ancfdae.integrators.energy_collocation import _SplitMatrix
 from ancfdae.integrators._linsolve import factorize
+from ancfdae.integrators._hbvm_numba import stage_residual
 from ancfdae.monitors import EnergyMonitor
 from ancfdae.problem import JacobianBlocks
 from support.flying_beams import CASES, b2, b3, momenta, total_energy
@@ -97,6 +98,31 @@ def test_split_matrix_is_the_exact_jacobian_with_one_stiffness():
     exact = factorize(st._assemble([K] * st.silent_stages, [zero, zero], st.h)).solve(r)
     split = factorize(_SplitMatrix(one, st.h, hbvm_coefficients(st.silent_stages, 2).X)).solve(r)
     assert np.abs(split - exact).max() <= 1e-10 * np.abs(exact).max()
+
+
+def test_compiled_stage_residual_equals_the_numpy_expression():
+    """``stage_residual`` against ``ih2 M Y + G BP^T - F BL^T`` (a non-symmetric CSR, random blocks), and the
+    stepper's residual against ``M Y / h^2 + _forces`` on a loaded B2 beam: equal to 1e-14 of the terms.
+
+    Catches: the CSR loop over columns instead of rows (the matrix is not symmetric), projection rows
+    swapped, the loads' sign, the mass term without ``1/h^2``. A wrong ``BP`` shared by both paths passes
+    here and fails the order and energy tests.
+    """
+    rng = np.random.default_rng(11)
+    n, k = 9, 5
+    M = sp.random(n, n, density=0.4, random_state=3, format="csr") + sp.identity(n, format="csr")
+    Y, G, F = rng.standard_normal((n, 2)), rng.standard_normal((n, k)), rng.standard_normal((n, 2))
+    BPT, BlT, ih2 = rng.standard_normal((k, 2)), rng.standard_normal((2, 2)), 1e4
+    R = np.empty((n, 2))
+    stage_residual(Y, G, BPT, F, BlT, M.data, M.indptr, M.indices, ih2, R)
+    ref = ih2 * (M @ Y) + G @ BPT - F @ BlT
+    scale = ih2 * (abs(M) @ abs(Y)) + abs(G) @ abs(BPT) + abs(F) @ abs(BlT)
+    assert np.abs(R - ref).max() <= 1e-14 * scale.max()
+    st, rng = _stepper(b2("BE2D", 2, T=0.5))
+    residual, _ = st.stage_equations(st.t, st.h, [True])
+    Y = 1e-4 * rng.standard_normal((st.n_dof, 2))
+    ref = (st._M @ Y) / st.h ** 2 + st._forces(st.t, st.h, Y)
+    assert np.abs(residual(Y.ravel()) - ref.ravel()).max() <= 1e-14 * np.abs(ref).max()
 
 
 def _differences(runs):
