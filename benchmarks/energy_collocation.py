@@ -53,11 +53,19 @@ SWEEP_B3 = {"lobatto3": (5e-3, 2.5e-3, 1.25e-3), "energy-collocation": (1e-2, 5e
 
 
 def method_of(label, model, h):
-    """``simulate`` keyword arguments of a method label."""
+    """``simulate`` keyword arguments of a method label; ``label:tol=X``: that label with Newton's relative
+    tolerance X (``lobatto3``, ``energy-collocation``)."""
+    if ":tol=" in label:
+        base, tol = label.split(":tol=")
+        kw = method_of(base, model, h)
+        kw["newton"] = NewtonOptions(tol=float(tol), jacobian="modified")
+        return kw
     if label == "lobatto3":
         return dict(method="lobatto3", h=h, newton=NewtonOptions(tol=1e-8, jacobian="modified"))
     if label == "energy-collocation":
         return dict(method="energy-collocation", h=h)
+    if label == "energy-collocation-newton":          # Newton to the energy's round-off, no velocity correction
+        return dict(method="energy-collocation", h=h, energy_correction="newton")
     if label == "energy-collocation-exact":
         return dict(method="energy-collocation", h=h, iteration_matrix="exact")
     if label.startswith("energy-collocation-k"):
@@ -136,17 +144,17 @@ def equal_accuracy(rows):
 def work_precision(a):
     sweep = SWEEP_B2 if a.problem.startswith("B2") else SWEEP_B3
     if a.methods:
-        sweep = {m: sweep[m] for m in a.methods}
+        sweep = {m: sweep[m.split(":")[0]] for m in a.methods}
     t_end = a.t_end
     h_ref = a.h_ref or min(sweep.get("energy-collocation", (2.5e-3,))) / 4
     for m in sweep:                                # compile every kernel before the timed runs
         model = PROBLEMS[a.problem][0]()
         simulate(model, (0.0, 0.05), **method_of(m, model, 1e-2), monitors=[EnergyMonitor()])
-    print(f"{a.problem}, [0, {t_end:g}] s; reference: energy-collocation, h = {h_ref:g}", flush=True)
-    ref = run_one(a.problem, "energy-collocation", h_ref, t_end, a.out)
+    print(f"{a.problem}, [0, {t_end:g}] s; reference: {a.ref_method}, h = {h_ref:g}", flush=True)
+    ref = run_one(a.problem, a.ref_method, h_ref, t_end, a.out)
     if not ref["ok"]:
         raise SystemExit(f"reference failed: {ref['message']}")
-    hs = sorted({h for v in sweep.values() for h in v}, reverse=True)
+    hs = sorted({h for v in sweep.values() for h in v if not a.hs or h in a.hs}, reverse=True)
     rows = []
     for h in hs:                                  # interleaved: every method at one step, then the next step
         for m, steps in sweep.items():
@@ -233,6 +241,8 @@ def main(argv=None):
                     help="long: k (default 'auto')")
     ap.add_argument("--cases", nargs="+", default=None, help="long: only these (e.g. SQ3D SQ3D-continuum)")
     ap.add_argument("--h-ref", type=float, default=None, help="step of the reference run (default: a quarter of the finest)")
+    ap.add_argument("--hs", type=float, nargs="+", default=None, help="wp: only these steps of the sweep")
+    ap.add_argument("--ref-method", default="energy-collocation", help="wp: the reference run's method label")
     ap.add_argument("--out", type=Path, default=Path("out/energy_collocation"))
     a = ap.parse_args(argv)
     if a.t_end is None:
