@@ -4,8 +4,12 @@ Run in a process with ``NUMBA_DISABLE_JIT=1`` (then ``@njit`` functions are thei
 source): the kernel's inputs are arrays of :class:`Counted`, the NumPy allocations inside the kernel
 module are redirected to such arrays, and every ``+ - * /`` and ``sqrt`` on a floating value adds one
 to the count. Index arithmetic (Python ints) and comparisons are not counted; a fused multiply-add
-counts 2. The count is that of the loop bodies as written, including multiplications by zero that the
-code does not skip -- the operations the compiled kernel executes, not a minimal count.
+counts 2. :func:`count` is that of the loop bodies as written, including multiplications by zero that
+the code does not skip -- the operations the compiled kernel executes. :func:`useful` leaves out the
+operations whose result needs no arithmetic: a product with a factor 0 or +-1, a sum or difference with
+a term 0, a quotient with numerator 0 or denominator +-1 (structural zeros and ones: an identity block,
+a shape function that vanishes at a node, a sign). A kernel's rate in useful flops is comparable across
+layouts that do or do not skip such operations.
 """
 from __future__ import annotations
 
@@ -13,9 +17,11 @@ import math
 
 import numpy as np
 
-__all__ = ["Counted", "CountingArray", "counting", "count", "patch_numpy"]
+__all__ = ["Counted", "CountingArray", "counting", "count", "useful", "patch_numpy"]
 
 _count = [0]
+_useful = [0]
+_TRIVIAL = {"+": (0.0,), "-": (0.0,), "*": (0.0, 1.0, -1.0)}
 
 
 def count() -> int:
@@ -23,8 +29,24 @@ def count() -> int:
     return _count[0]
 
 
+def useful() -> int:
+    """Operations counted so far that needed arithmetic (see the module docstring)."""
+    return _useful[0]
+
+
+def _is_trivial(op, a, b):
+    """Whether ``a op b`` (``a`` the left operand) needs no arithmetic."""
+    if op == "/":
+        return a == 0.0 or b in (1.0, -1.0)
+    triv = _TRIVIAL[op]
+    return a in triv or b in triv
+
+
 def _val(x):
     return x.v if isinstance(x, Counted) else x
+
+
+_OPS = {"+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b, "/": lambda a, b: a / b}
 
 
 class Counted:
@@ -35,18 +57,21 @@ class Counted:
     def __init__(self, v):
         self.v = float(v)
 
-    def _op(self, other, f):
+    def _op(self, other, op, left=True):
         _count[0] += 1
-        return Counted(f(self.v, _val(other)))
+        a, b = (self.v, float(_val(other))) if left else (float(_val(other)), self.v)
+        if not _is_trivial(op, a, b):
+            _useful[0] += 1
+        return Counted(_OPS[op](a, b))
 
-    def __add__(self, o): return self._op(o, lambda a, b: a + b)
-    def __radd__(self, o): return self._op(o, lambda a, b: b + a)
-    def __sub__(self, o): return self._op(o, lambda a, b: a - b)
-    def __rsub__(self, o): return self._op(o, lambda a, b: b - a)
-    def __mul__(self, o): return self._op(o, lambda a, b: a * b)
-    def __rmul__(self, o): return self._op(o, lambda a, b: b * a)
-    def __truediv__(self, o): return self._op(o, lambda a, b: a / b)
-    def __rtruediv__(self, o): return self._op(o, lambda a, b: b / a)
+    def __add__(self, o): return self._op(o, "+")
+    def __radd__(self, o): return self._op(o, "+", False)
+    def __sub__(self, o): return self._op(o, "-")
+    def __rsub__(self, o): return self._op(o, "-", False)
+    def __mul__(self, o): return self._op(o, "*")
+    def __rmul__(self, o): return self._op(o, "*", False)
+    def __truediv__(self, o): return self._op(o, "/")
+    def __rtruediv__(self, o): return self._op(o, "/", False)
     def __neg__(self): return Counted(-self.v)
     def __float__(self): return self.v
     def __eq__(self, o): return self.v == _val(o)
@@ -57,6 +82,7 @@ class Counted:
 
     def sqrt(self):
         _count[0] += 1
+        _useful[0] += 1
         return Counted(math.sqrt(self.v))
 
 

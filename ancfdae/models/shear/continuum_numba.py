@@ -28,7 +28,8 @@ def continuum_point(dim, v, blk, coef, cnt, ws, Ds, ref, wax, vi, vj, X, eps, si
     v : (n_v,) local variables. blk, coef : (S, dim, 3); cnt : (S, dim). ws : (S,) section weights.
     Ds : (S, n_voigt, n_voigt) elasticity per section point. ref : (S, n_voigt) reference strains.
     wax : axial weight. vi, vj : (n_voigt,) Voigt index pairs.
-    X (dim, dim), eps, sig (n_voigt,), S (dim, dim), Bm, DB (n_voigt, dim * dim), HX (dim * dim,) * 2: work.
+    X (dim, dim), eps, sig (n_voigt,), S (dim, dim), DB (n_voigt, dim * dim), HX (dim * dim,) * 2: work;
+    Bm (n_voigt, dim * dim): unused (DB is formed from X directly), kept for the callers.
     """
     nvo = vi.shape[0]
     ndd = dim * dim
@@ -76,30 +77,40 @@ def continuum_point(dim, v, blk, coef, cnt, ws, Ds, ref, wax, vi, vj, X, eps, si
                     g[blk[s, c, m] * dim + i] += coef[s, c, m] * x
         if order == 1:
             continue
-        # d eps_a / d X_ic, then HX = delta_ij S_cd + Bm^T D Bm (in X), then mapped onto v.
-        Bm[:, :] = 0.0
+        # d eps_a / d X_ic (Bm: row a is X[:, r] in column p and X[:, p] in column r, one column for a
+        # normal strain), DB = D Bm over the nonzeros of D and Bm (the split D0 is diagonal), then
+        # HX = delta_ij S_cd + Bm^T D Bm (in X) row by row over Bm's nonzeros, then mapped onto v.
+        for a in range(nvo):
+            for k in range(ndd):
+                DB[a, k] = 0.0
+        for b in range(nvo):
+            p, r = vi[b], vj[b]
+            for a in range(nvo):
+                dab = Ds[s, a, b]
+                if dab == 0.0:
+                    continue
+                for i in range(dim):
+                    DB[a, i * dim + p] += dab * X[i, r]
+                    if p != r:
+                        DB[a, i * dim + r] += dab * X[i, p]
+        for k in range(ndd):                 # upper triangle, then scaled and mirrored
+            for l in range(k, ndd):
+                HX[k, l] = S[k % dim, l % dim] if k // dim == l // dim else 0.0
         for a in range(nvo):
             p, r = vi[a], vj[a]
             for i in range(dim):
-                if p == r:
-                    Bm[a, i * dim + p] = X[i, p]
-                else:
-                    Bm[a, i * dim + p] = X[i, r]
-                    Bm[a, i * dim + r] = X[i, p]
-        for a in range(nvo):
-            for k in range(ndd):
-                x = 0.0
-                for b in range(nvo):
-                    x += Ds[s, a, b] * Bm[b, k]
-                DB[a, k] = x
+                x = X[i, r]
+                k = i * dim + p
+                for l in range(k, ndd):
+                    HX[k, l] += x * DB[a, l]
+                if p != r:
+                    x = X[i, p]
+                    k = i * dim + r
+                    for l in range(k, ndd):
+                        HX[k, l] += x * DB[a, l]
         for k in range(ndd):
             for l in range(k, ndd):
-                x = 0.0
-                for a in range(nvo):
-                    x += Bm[a, k] * DB[a, l]
-                if k // dim == l // dim:
-                    x += S[k % dim, l % dim]
-                x *= w
+                x = HX[k, l] * w
                 HX[k, l] = x
                 HX[l, k] = x
         for i in range(dim):

@@ -36,6 +36,7 @@ from ..element import OnePassKernel
 from .continuum import voigt
 from .continuum_numba import continuum_point
 from .moment_numba import sq_moment_load
+from .structural3d_numba import sq3d_structural_elements
 from .structural_numba import N_JETS, needs_frame, structural_point
 
 __all__ = ["SQCompiled", "compiled_geometry", "sq_structural", "sq_continuum", "sq_structural_fused",
@@ -149,11 +150,8 @@ def sq_structural(q, N, dN, Dw, ref, dim, order):
     v, g, H = np.empty(nv), np.zeros(nv), np.zeros((nv, nv))
     JV, JG, JH = np.zeros((N_JETS, 3)), np.zeros((N_JETS, 3, npv)), np.zeros((N_JETS, 3, npv, npv))
     eps, sig, Jm = np.empty(nk), np.empty(nk), np.zeros((nk, nv))
-    # The dimension as a literal in each branch: the inlined gather and scatter loops over it unroll.
-    if dim == 3:
-        for e in range(n_el):
-            W[e] = _structural_element(3, q[e], N[e], dN[e], Dw[e], ref[e], f[e], K[e if order >= 2 else 0],
-                                       order, Sb, col, v, g, H, JV, JG, JH, eps, sig, Jm)
+    if dim == 3:      # SQ3D: sparse point blocks and the two-pass scatter
+        sq3d_structural_elements(q, N, dN, Dw, ref, order, Sb, col, W, f, K)
     else:
         for e in range(n_el):
             W[e] = _structural_element(2, q[e], N[e], dN[e], Dw[e], ref[e], f[e], K[e if order >= 2 else 0],

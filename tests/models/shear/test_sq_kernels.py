@@ -61,6 +61,18 @@ def test_numba_kernel_with_one_rule_for_all_terms(steel, cls):
         assert rel_err(W1, W0) < 1e-12 and rel_err(f1, f0) < 1e-12 and rel_err(K1, K0) < 1e-12
 
 
+@pytest.mark.parametrize("nodes", [3, 2])
+def test_sq3d_cross_section_points_off_the_nodes(steel, nodes):
+    """Cross-section terms at 2 Gauss points, the frame terms at 3: every shape function is nonzero at the
+    cross-section-only points. Catches a compiled SQ3D scatter that assumes ``N = delta`` there (the default
+    end-point rule) or that drops the derivative blocks of a frame point."""
+    quad = {"axial": 3, "shear": 3, "bending": 3, "cross_section": 2}
+    el, beam, qs = _beam_and_states(steel, SQ3D, "structural", nodes, quadrature=quad, n_states=2)
+    for q in qs:
+        (W0, f0, K0), (W1, f1, K1) = _both(el, beam.geom, q)
+        assert rel_err(W1, W0) < 1e-12 and rel_err(f1, f0) < 1e-12 and rel_err(K1, K0) < 1e-12
+
+
 @pytest.mark.parametrize("cls", [SQ2D, SQ3D])
 @pytest.mark.parametrize("formulation", FORMULATIONS)
 def test_numba_forces_are_energy_gradient_and_tangent_is_exact(steel, cls, formulation):
