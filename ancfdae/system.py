@@ -166,6 +166,12 @@ class System(BodyStack):
             return self._joint_set.terms_at(t)
         return lambda q, lam: (self.constraints(t, q), self.constraint_force(t, q, lam))
 
+    @property
+    def compiled_rows(self):
+        """The one compiled set of every constraint row (:class:`~ancfdae.joints.assembled_numba.CompiledConstraintSet`,
+        the bodies' rows first), or None when some rows are evaluated body by body or by the NumPy reference."""
+        return self._joint_set if not self._body_rows and hasattr(self._joint_set, "terms_at") else None
+
     def constraint_position_terms_at(self, t: float) -> Callable[[np.ndarray], tuple]:
         """``q -> (g, G, g_t)`` at the time ``t`` (a GGL stage's rows): one compiled pass when every row is
         folded, else :meth:`constraints`, :meth:`constraint_jacobian` and :meth:`constraint_rates`."""

@@ -20,10 +20,11 @@ from ..beam.assembly_numba import gather_elements, scatter
 from ...integrators._affine import affine3
 from ..beam.iteration_numba import alpha_finish, alpha_update, carry_on
 from ...integrators._alpha_steps_numba import alpha_steps
+from ...integrators._index3_steps_numba import index3_steps
 from ..element import Kernel
 
-__all__ = ["BE2DCompiled", "be2d_forces", "be2d_fused", "be2d_alpha_iterations", "be2d_alpha_steps", "STRUCTURAL",
-           "CONTINUUM"]
+__all__ = ["BE2DCompiled", "be2d_forces", "be2d_fused", "be2d_alpha_iterations", "be2d_alpha_steps",
+           "be2d_index3_steps", "STRUCTURAL", "CONTINUUM"]
 
 STRUCTURAL, CONTINUUM = 0, 1
 
@@ -199,6 +200,14 @@ def be2d_alpha_steps(S, P, fpar, ipar, out, lub, piv, gravity, dead, scales, arr
     alpha_steps(be2d_alpha_iterations, S, P, fpar, ipar, out, lub, piv, gravity, dead, scales, arrays, element_args)
 
 
+@njit(cache=True)
+def be2d_index3_steps(S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv, W, E, cons, rigid, beam, element_args):
+    """Index-3 steps of a System holding a BE2D beam in one call (contract in
+    :mod:`ancfdae.integrators._index3_steps_numba`)."""
+    index3_steps(be2d_fused, S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv, W, E, cons, rigid, beam,
+                 element_args)
+
+
 class BE2DCompiled(Kernel):
     """The compiled kernel object of BE2D: :func:`be2d_forces` and the fused entry point :func:`be2d_fused`."""
 
@@ -233,3 +242,7 @@ class BE2DCompiled(Kernel):
     def alpha_steps(self, geom: dict) -> tuple:
         """``(be2d_alpha_steps, args)``: compiled whole steps (:mod:`ancfdae.integrators._alpha_steps_numba`)."""
         return be2d_alpha_steps, self._args(geom)
+
+    def index3_steps(self, geom: dict) -> tuple:
+        """``(be2d_index3_steps, args)``: whole index-3 steps of a System (:mod:`ancfdae.integrators._index3_steps_numba`)."""
+        return be2d_index3_steps, self._args(geom)
