@@ -4,12 +4,13 @@ When nothing needs the state between two output times the driver asks the steppe
 next one at once (:meth:`ancfdae.integrators.newmark._AlphaFamily.steps_until`). On a constrained model that
 is a :class:`ancfdae.System` of one beam whose element offers compiled index-3 steps (BE2D:
 :func:`ancfdae.models.thin.be2d_numba.be2d_index3_steps`) and rigid bodies, with every constraint row in the
-compiled set (:attr:`ancfdae.System.compiled_rows`), :class:`Index3Steps` packs the system's constant arrays
-once and runs the steps in one compiled call (contract and decisions in
+compiled set (its :attr:`~ancfdae.System.compiled_arrays`, :mod:`ancfdae.system_compiled`), :class:`Index3Steps`
+runs the steps in one compiled call (contract and decisions in
 :mod:`ancfdae.integrators._index3_steps_numba`): the predictor, the modified-Newton iterations, the refresh
 of the KKT matrix and its dense LU, the update of ``q, v, a, ah, lam`` and the counters. The time functions
 (the joints' drives, the rigid bodies' and the beam's loads) are evaluated here, before the call, at the ends
-of the coming steps: one call of each user function per step and time (a table), not one per iteration.
+of the coming steps: one call of each user function per step (a table kept for :data:`TABLE_STEPS` steps),
+not one per iteration.
 
 A step that needs a decision of Python (a failure, the solver's retry) is taken by the ordinary Python step,
 which redoes it from its start with the factors the compiled steps left (a dense factorisation is handed
@@ -25,14 +26,15 @@ from ancfdae.integrators._linsolve import _Banded
 from ancfdae.integrators._newton import _Factor
 from ancfdae.integrators.driver import GRID_TOL
 from ancfdae.integrators.protocol import StepOutcome
+from ancfdae.system_compiled import SystemArrays
 
 __all__ = ["Index3Steps"]
 
 #: at most this many steps per compiled call (Ctrl-C and the progress bar are served between calls)
 STEPS_PER_CALL = 500
-#: the compiled path factorises the KKT matrix densely: offered up to this many unknowns ``n + m``
-#: (dense LU of 62 unknowns, B6: some 20 us; above a few hundred banded or sparse factors win)
-DENSE_MAX = 200
+#: the time functions are tabulated this many steps ahead (one table serves the calls up to several output
+#: times; B5 with an output every 4 steps: 236 us of Python per call when tabulated per call)
+TABLE_STEPS = 256
 
 
 class _DenseLU:
@@ -49,115 +51,60 @@ class _DenseLU:
         return x
 
 
-def _coo(block: np.ndarray, offset: int):
-    i, j = np.nonzero(block)
-    return i + offset, j + offset, block[i, j]
-
-
 class Index3Steps:
     """A System's compiled index-3 steps for one Newmark-family stepper (see the module docstring).
 
     Use :meth:`offer`; the constructor takes what it found there.
     """
 
-    def __init__(self, stepper, rows, beam_at, compiled, rigid_bodies):
+    def __init__(self, stepper, arrays: SystemArrays) -> None:
         s, o, model = stepper, stepper.newton.options, stepper.model.wrapped
-        n, m = model.n_dof, model.n_constraints
-        self._fn, self._stepper, self._rows = compiled.index3_steps, stepper, rows
-        cons = (rows.lin_term, rows.lin_row, rows.lin_col, rows.lin_val, rows.const_term, rows.const_row,
-                rows.const_val, rows.qi, rows.qj, rows.qk, rows.qa, rows.lin_slot, rows._q_slot,
-                rows.G_pattern.indptr.astype(np.int64), rows.G_pattern.indices.astype(np.int64))
-        self._cons = tuple(np.ascontiguousarray(a) for a in cons)
-        n_w = 1 + len(rows.timed)
-        times, mi, mj, mv, ci, cj, cv, ccol, fvec, fcol = [], [], [], [], [], [], [], [], [], []
-        grav, ridx = np.zeros(n), []
-        for body, off in rigid_bodies:
-            M, fg, forces, moments = body.residual_parts()
-            nb = M.shape[0]
-            ridx.extend(range(off, off + nb))
-            for a, b in zip((mi, mj, mv), _coo(M, off)):
-                a.append(b)
-            grav[off:off + nb] = fg
-            for time, f in forces:
-                fv = np.zeros(n)
-                fv[off:off + nb] = f
-                fvec.append(fv)
-                fcol.append(n_w + len(times))
-                times.append(time)
-            for time, C in moments:
-                i, j, c = _coo(C, off)
-                ci.append(i)
-                cj.append(j)
-                cv.append(c)
-                ccol.append(np.full(i.size, n_w + len(times)))
-                times.append(time)
-        cat = (lambda x, dt: np.concatenate(x).astype(dt) if x else np.zeros(0, dt))
-        self._rigid = (np.array(ridx, dtype=np.int64), cat(mi, np.int64), cat(mj, np.int64), cat(mv, float),
-                       grav, np.array(fvec, dtype=float).reshape(len(fvec), n), np.array(fcol, dtype=np.int64),
-                       cat(ci, np.int64), cat(cj, np.int64), cat(cv, float), cat(ccol, np.int64))
-        self._times = times
-        beam, off = beam_at
-        q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices = compiled.arrays
-        self._beam = (int(off), int(beam.n_dof), q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices)
-        self._element = compiled.element_args
-        # the beam's external force: gravity alone is constant; dead loads need their time functions
-        self._external = compiled.external if compiled.dead_times else None
-        self._E = np.ascontiguousarray(compiled.external(s.t0)[None, :], dtype=float)
+        self._fn, self._stepper, self._arrays = arrays.compiled.index3_steps, stepper, arrays
         f = np.zeros(sn.N_FPAR)
         f[[sn.T0, sn.H, sn.T_BOUND, sn.BETA, sn.GAMMA, sn.ALPHA_M, sn.ALPHA_F, sn.TOL, sn.CONTRACTION,
            sn.GRID_TOL, sn.MSCALE, sn.XTOL, sn.LOAD_FACTOR, sn.FLOOR_FACTOR]] = (
             s.t0, s.h, s.t_bound, s.beta, s.gamma, s.alpha_m, s.alpha_f, o.tol, o.contraction, GRID_TOL,
-            s._mscale, o.xtol, compiled.load_factor, s.FLOOR_ROUNDOFF)
+            s._mscale, o.xtol, arrays.load_factor, s.FLOOR_ROUNDOFF)
         self._fpar = f
-        N = n + m
+        N = model.n_dof + model.n_constraints
         self._LU, self._piv = np.zeros((N, N)), np.zeros(N, dtype=np.int64)
         self._LUs, self._pivs = np.zeros((N, N)), np.zeros(N, dtype=np.int64)
         self._no_band = (np.zeros((1, 1), order="F"), np.zeros(1, dtype=np.int32))   # LAPACK's types
+        self._table, self._grid = (0, np.zeros((0, arrays.n_weights)), None), None   # (first step, W, E), grid
 
     @classmethod
     def offer(cls, stepper) -> "Index3Steps | None":
-        """The compiled steps for ``stepper``'s constrained model, or None when it is not such a System (one beam
-        offering ``index3_steps``, rigid bodies, every row compiled, at most :data:`DENSE_MAX` unknowns) or
-        Newton is not modified."""
-        model = stepper.model.wrapped
-        rows = getattr(model, "compiled_rows", None)
-        if rows is None or stepper.newton.options.jacobian != "modified" or not model.n_constraints:
+        """The compiled steps for ``stepper``'s constrained model, or None when it is not such a System
+        (:attr:`ancfdae.System.compiled_arrays`) or Newton is not modified."""
+        if stepper.newton.options.jacobian != "modified":
             return None
-        if model.n_dof + model.n_constraints > DENSE_MAX:
-            return None
-        beams, rigid = [], []
-        for body, off in zip(model.bodies, model.offsets):
-            offer = getattr(body, "compiled_residual", None)
-            if offer is not None:
-                compiled = offer()
-                if compiled is None or compiled.index3_steps is None:
-                    return None
-                beams.append(((body, off), compiled))
-            elif callable(getattr(body, "residual_parts", None)):
-                rigid.append((body, int(off)))
-            else:
-                return None
-        if len(beams) != 1:
-            return None
-        (beam_at, compiled), = beams
-        return cls(stepper, rows, beam_at, compiled, rigid)
+        arrays = getattr(stepper.model.wrapped, "compiled_arrays", None)
+        return None if arrays is None else cls(stepper, arrays)
 
     def _tables(self, t_stop, max_count):
-        """``(W, E)``: the time weights and the beam's external force at the ends of the coming steps."""
+        """``(W, E)``: the time weights and the beam's external force at the ends of the coming steps (at least
+        up to ``t_stop``), or ``(None, None)`` when a time function fails there (the Python steps reach it and
+        fail at its step). Tabulated :data:`TABLE_STEPS` steps ahead and kept: one table serves several calls."""
         s = self._stepper
-        h = s.h
+        h, first = s.h, s.n_steps + 1
         k = int(max(1, min(max_count, (t_stop - s.t) / h + 2)))
-        t_new = s.t0 + (s.n_steps + 1 + np.arange(k)) * h
-        t_new[t_new >= s.t_bound - GRID_TOL * h] = s.t_bound
-        try:
-            W = self._rows.weight_table(t_new)
-        except ValueError:   # a bad time function: the Python steps reach it and fail at its step, with its message
-            return None, None
-        if self._times:
-            W = np.hstack((W, np.array([[float(time(t)) for time in self._times] for t in t_new])))
-        E = (self._E if self._external is None else
-             np.array([self._external(t) for t in t_new], dtype=float))
-        return np.ascontiguousarray(W), np.ascontiguousarray(E)
+        start, W, E = self._table
+        if not (start <= first and first + k <= start + W.shape[0] and self._grid == (s.t0, h, s.t_bound)):
+            W = E = None
+            for size in (max(k, TABLE_STEPS), k):   # a bad time ahead: only the steps needed now
+                t_new = s.t0 + (first + np.arange(size)) * h
+                t_new[t_new >= s.t_bound - GRID_TOL * h] = s.t_bound
+                t_new = t_new[:int(np.searchsorted(t_new, s.t_bound)) + 1]   # nothing past the end
+                try:
+                    W, E = self._arrays.weights(t_new), self._arrays.external(t_new)
+                    break
+                except ValueError:
+                    continue
+            if W is None:
+                return None, None
+            start, self._table, self._grid = first, (first, W, E), (s.t0, h, s.t_bound)
+        i = first - start
+        return W[i:], (E if E.shape[0] == 1 else E[i:])
 
     def run(self, t_stop: float, max_count: int) -> tuple[StepOutcome, int]:
         """``(outcome, taken)`` as :meth:`ancfdae.integrators.newmark._AlphaFamily.steps_until`."""
@@ -177,15 +124,17 @@ class Index3Steps:
         if W is None:
             return s.step(), 0
         f = self._fpar.copy()
-        f[[sn.T, sn.T_STOP, sn.H_MATRIX, sn.ATOL, sn.FLOOR]] = (s.t, t_stop, s._h_matrix or 0.0, s._atol, s._floor)
-        ipar = np.array([s.n_steps, max_count, newton.options.max_iter, kind, s._h_matrix is not None, kl, ku],
+        f[sn.T], f[sn.T_STOP], f[sn.H_MATRIX], f[sn.ATOL], f[sn.FLOOR] = (s.t, t_stop, s._h_matrix or 0.0, s._atol,
+                                                                          s._floor)
+        ipar = np.array((s.n_steps, max_count, newton.options.max_iter, kind, s._h_matrix is not None, kl, ku),
                         dtype=np.int64)
-        S = np.stack((s.q, s.v, s.a, s._ah))
-        P = np.empty_like(S)
-        L = np.stack((s.lam, s.lam))
+        n, m = s.q.size, s.lam.size
+        S, P, L = np.empty((4, n)), np.empty((4, n)), np.empty((2, m))
+        S[0], S[1], S[2], S[3], L[0], L[1] = s.q, s.v, s.a, s._ah, s.lam, s.lam
         out = np.zeros(sn.N_OUT, dtype=np.int64)
-        self._fn(S, P, L, f, ipar, out, self._LU, self._piv, self._LUs, self._pivs, lub, bpiv, W, E, self._cons,
-                 self._rigid, self._beam, self._element)
+        a = self._arrays
+        self._fn(S, P, L, f, ipar, out, self._LU, self._piv, self._LUs, self._pivs, lub, bpiv, W, E, a.cons, a.rigid,
+                 a.beam, a.element_args)
         done, status, iterations, evals, jacs = (int(x) for x in out)
         st = newton.stats
         st.iterations += iterations

@@ -36,10 +36,10 @@ from numba import njit
 
 from ancfdae.integrators._linsolve_numba import band_solve
 from ancfdae.integrators._newton import max_abs
-from ancfdae.joints.assembled_numba import _g_force
+from ancfdae.joints.assembled_numba import _g_force, _rates
 from ancfdae.models.beam.assembly_numba import finish_residual
 
-__all__ = ["index3_steps", "dense_lu", "dense_solve"]
+__all__ = ["index3_steps", "system_multipliers", "dense_lu", "dense_solve"]
 
 # fpar
 T0, H, T, T_BOUND, T_STOP, H_MATRIX, BETA, GAMMA, ALPHA_M, ALPHA_F, TOL, ATOL, FLOOR, CONTRACTION, GRID_TOL, \
@@ -323,3 +323,50 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv,
     fpar[FLOOR], fpar[H_MATRIX] = floor, h_matrix
     ipar[KIND], ipar[HAVE_H] = kind, have_h
     out[DONE], out[STATUS], out[ITERATIONS], out[RESIDUALS], out[JACOBIANS] = done, status, iters, evals, jacs
+
+
+@njit(inline="always")
+def system_multipliers(fused, W, ext, q, v, a_out, lam_out, cons, rigid, beam, eargs, lf):
+    """``(a, lam)`` from ``[[M, G^T], [G, 0]] [a; lam] = [-r(t, q, v, 0); gamma]`` (:func:`ancfdae.constrained.multipliers`)
+    into ``a_out``, ``lam_out``: ``W`` (3, nw) the time weights at ``t`` and their derivatives, ``ext`` the beam's
+    external force at ``t``, ``lf`` its load factor; a singular matrix gives non-finite values."""
+    n, m = q.size, lam_out.size
+    N = n + m
+    ob, nb, q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices = beam
+    lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa, ls, qslot, g_indptr, g_indices = cons
+    ridx, mi, mj, mv, grav, fvec, fcol, ci, cj, cvv, ccol = rigid
+    zero, r = np.zeros(n), np.zeros(n)
+    rbuf, kbuf = np.empty(nb + 1), np.empty(1)
+    fused(q[ob:ob + nb], q_fixed, gather, vec_slot, mat_slot, False, rbuf, kbuf, *eargs)
+    finish_residual(rbuf, m_data, indptr, indices, zero[ob:ob + nb], lf, ext)
+    _rigid_residual(r, q, zero, W[0], rigid)
+    for i in range(nb):
+        r[ob + i] = rbuf[i]
+    gt, gamma = np.empty(m), np.empty(m)
+    _rates(W[1], W[2], lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa, q, v, gt, gamma)
+    A, rhs = np.zeros((N, N)), np.empty(N)
+    for i in range(nb):
+        for jj in range(indptr[i], indptr[i + 1]):
+            A[ob + i, ob + indices[jj]] += m_data[jj]
+    for e in range(mi.size):
+        A[mi[e], mj[e]] += mv[e]
+    gdata = np.zeros(g_indices.size)
+    for e in range(lt.size):
+        gdata[ls[e]] += W[0, lt[e]] * lv[e]
+    for e in range(qi.size):
+        gdata[qslot[e]] += qa[e] * q[qk[e]]
+    for i in range(m):
+        for jj in range(g_indptr[i], g_indptr[i + 1]):
+            A[n + i, g_indices[jj]] += gdata[jj]
+            A[g_indices[jj], n + i] += gdata[jj]
+    for i in range(n):
+        rhs[i] = -r[i]
+    for i in range(m):
+        rhs[n + i] = gamma[i]
+    piv = np.empty(N, dtype=np.int64)
+    dense_lu(A, piv)
+    dense_solve(A, piv, rhs)
+    for i in range(n):
+        a_out[i] = rhs[i]
+    for i in range(m):
+        lam_out[i] = rhs[n + i]

@@ -73,8 +73,8 @@ class _Component:
         return tuple(x[self.k] for x in self.p(t))
 
     def table(self, times: np.ndarray) -> np.ndarray:
-        """``phi`` at each of ``times`` (k,)."""
-        return self.p.table(times)[:, 0, self.k]
+        """``phi`` and its two derivatives at each of ``times``, (k, 3)."""
+        return self.p.table(times)[:, :, self.k]
 
 
 class _AngleTerm:
@@ -90,9 +90,12 @@ class _AngleTerm:
         return -np.sin(a), -np.cos(a) * w, np.sin(a) * w * w - np.cos(a) * al
 
     def table(self, times: np.ndarray) -> np.ndarray:
-        """``phi`` at each of ``times`` (k,)."""
-        a = self.th.table(times)[:, 0, 0]
-        return np.cos(a) if self.cos else -np.sin(a)
+        """``phi`` and its two derivatives at each of ``times``, (k, 3) (the expressions of ``__call__``)."""
+        tab = self.th.table(times)[:, :, 0]
+        a, w, al = tab[:, 0], tab[:, 1], tab[:, 2]
+        if self.cos:
+            return np.column_stack((np.cos(a), -np.sin(a) * w, -np.cos(a) * w * w - np.sin(a) * al))
+        return np.column_stack((-np.sin(a), -np.cos(a) * w, np.sin(a) * w * w - np.cos(a) * al))
 
 
 class Prescribed(Joint):

@@ -25,7 +25,7 @@ COUNTS = ("steps", "newton_iterations", "newton_solves", "residual_evals", "jaco
           "retries", "failed_solves")
 
 
-def _both(system, monkeypatch, t_end, **kw):
+def _both(system, monkeypatch, t_end, method="generalized-alpha", **kw):
     taken = []
     run = _index3_steps.Index3Steps.run
 
@@ -34,9 +34,9 @@ def _both(system, monkeypatch, t_end, **kw):
         taken.append(out[1])
         return out
     monkeypatch.setattr(_index3_steps.Index3Steps, "run", spy)
-    fast = simulate(system, (0.0, t_end), "generalized-alpha", **kw)
+    fast = simulate(system, (0.0, t_end), method, **kw)
     monkeypatch.setattr(newmark._AlphaFamily, "steps_until", None)   # the driver's step-by-step loop
-    slow = simulate(system, (0.0, t_end), "generalized-alpha", **kw)
+    slow = simulate(system, (0.0, t_end), method, **kw)
     monkeypatch.undo()
     return fast, slow, sum(taken)
 
@@ -84,12 +84,14 @@ def _loaded(dead=True, force=lambda t: np.cos(20 * t), angle=lambda t: (np.array
     return System([beam, body], [drive, Spherical((beam, -1), (body, (0.0, 0.0)))])
 
 
-@pytest.mark.parametrize("dead", [True, False])
-def test_loaded_system_matches_the_python_path(dead, monkeypatch):
+@pytest.mark.parametrize("dead, method, opts", [(True, "generalized-alpha", {"rho_inf": 0.8}),
+                                                (False, "generalized-alpha", {"rho_inf": 0.8}),
+                                                (True, "hht", {"alpha": 0.1}), (True, "newmark", {"beta": 0.3025, "gamma": 0.6})])
+def test_loaded_system_matches_the_python_path(dead, method, opts, monkeypatch):
     # t_end off the output grid and off the step grid: a shortened last step (a new matrix in the compiled call)
     t_eval = [0.0, 0.01, 0.0155, 0.03, 0.0405]
-    fast, slow, taken = _both(_loaded(dead), monkeypatch, 0.0405, h=5e-4, rho_inf=0.8, t_eval=t_eval,
-                              newton={"tol": 1e-10, "contraction": 0.2})
+    fast, slow, taken = _both(_loaded(dead), monkeypatch, 0.0405, method, h=5e-4, t_eval=t_eval,
+                              newton={"tol": 1e-10, "contraction": 0.2}, **opts)
     assert fast.status == slow.status == "success"
     _same(fast, slow)
     assert taken > fast.stats["steps"] // 2

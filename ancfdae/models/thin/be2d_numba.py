@@ -20,11 +20,11 @@ from ..beam.assembly_numba import gather_elements, scatter
 from ...integrators._affine import affine3
 from ..beam.iteration_numba import alpha_finish, alpha_update, carry_on
 from ...integrators._alpha_steps_numba import alpha_steps
-from ...integrators._index3_steps_numba import index3_steps
+from ...integrators._index3_steps_numba import index3_steps, system_multipliers
 from ..element import Kernel
 
 __all__ = ["BE2DCompiled", "be2d_forces", "be2d_fused", "be2d_alpha_iterations", "be2d_alpha_steps",
-           "be2d_index3_steps", "STRUCTURAL", "CONTINUUM"]
+           "be2d_index3_steps", "be2d_multipliers", "STRUCTURAL", "CONTINUUM"]
 
 STRUCTURAL, CONTINUUM = 0, 1
 
@@ -208,6 +208,12 @@ def be2d_index3_steps(S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv, W
                  element_args)
 
 
+@njit(cache=True)
+def be2d_multipliers(W, ext, q, v, a, lam, cons, rigid, beam, element_args, load_factor):
+    """A System's ``(a, lam)`` at an output time in one call (:func:`ancfdae.integrators._index3_steps_numba.system_multipliers`)."""
+    system_multipliers(be2d_fused, W, ext, q, v, a, lam, cons, rigid, beam, element_args, load_factor)
+
+
 class BE2DCompiled(Kernel):
     """The compiled kernel object of BE2D: :func:`be2d_forces` and the fused entry point :func:`be2d_fused`."""
 
@@ -246,3 +252,7 @@ class BE2DCompiled(Kernel):
     def index3_steps(self, geom: dict) -> tuple:
         """``(be2d_index3_steps, args)``: whole index-3 steps of a System (:mod:`ancfdae.integrators._index3_steps_numba`)."""
         return be2d_index3_steps, self._args(geom)
+
+    def multipliers(self, geom: dict) -> tuple:
+        """``(be2d_multipliers, args)``: a System's reactions at an output time (:mod:`ancfdae.system_compiled`)."""
+        return be2d_multipliers, self._args(geom)
