@@ -9,6 +9,7 @@ given (:mod:`ancfdae.joints`). The equations are ``r(t, q, v, a) + G^T lam = 0``
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
@@ -20,6 +21,10 @@ from ancfdae.joints.base import Frame, Joint
 from ancfdae.joints.rows import Affine, Rows
 from ancfdae.problem import capabilities
 from ancfdae.system_stack import BodyStack
+
+if TYPE_CHECKING:
+    from ancfdae.joints.assembled_numba import CompiledConstraintSet
+    from ancfdae.system_compiled import SystemArrays
 
 __all__ = ["System"]
 
@@ -168,13 +173,13 @@ class System(BodyStack):
         return lambda q, lam: (self.constraints(t, q), self.constraint_force(t, q, lam))
 
     @property
-    def compiled_rows(self):
+    def compiled_rows(self) -> "CompiledConstraintSet | None":
         """The one compiled set of every constraint row (:class:`~ancfdae.joints.assembled_numba.CompiledConstraintSet`,
         the bodies' rows first), or None when some rows are evaluated body by body or by the NumPy reference."""
         return self._joint_set if not self._body_rows and hasattr(self._joint_set, "terms_at") else None
 
     @property
-    def compiled_arrays(self):
+    def compiled_arrays(self) -> "SystemArrays | None":
         """The system as flat arrays for compiled steps and reactions
         (:class:`ancfdae.system_compiled.SystemArrays`, made once), or None when it has no compiled form."""
         if self._compiled is None:
