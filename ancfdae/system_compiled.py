@@ -91,12 +91,16 @@ class SystemArrays:
         q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices = compiled.arrays
         self.beam = (int(off), int(beam.n_dof), q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices)
         self.element_args = compiled.element_args
-        self.compiled = compiled
-        self.load_factor = compiled.load_factor
+        self.compiled, self._beam_model = compiled, beam
         # the beam's external force: gravity alone is constant; dead loads need their time functions
         self._dead = bool(compiled.dead_times)
         self._E = np.ascontiguousarray(compiled.external(0.0)[None, :], dtype=float)
         self._last = (np.zeros(0), np.zeros((0, 3, self.n_weights)))
+
+    @property
+    def load_factor(self) -> float:
+        """The beam's load factor now (read at each use: a static solve steps it)."""
+        return float(self._beam_model.load_factor)
 
     @classmethod
     def of(cls, system) -> "SystemArrays | None":
