@@ -25,8 +25,8 @@ from ancfdae.integrators._newton import max_abs
 
 __all__ = ["SystemArrays"]
 
-#: the compiled paths factorise the KKT matrix densely: offered up to this many unknowns ``n + m``
-#: (dense LU of 62 unknowns, B6: 53 us; a solve 3.8 us)
+#: the compiled paths factorise the KKT matrix densely: offered up to this many unknowns ``n + m`` (B6's 62: LU
+#: 59 us, a solve 4.4 us, ``python -m benchmarks.index3_cost``; the LU grows as N^3, a banded one would be next)
 DENSE_MAX = 200
 
 
