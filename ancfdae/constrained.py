@@ -71,6 +71,10 @@ def multipliers(model, t: float, q: np.ndarray, v: np.ndarray, *,
     a : ndarray, shape (n,)
     lam : ndarray, shape (m,)
     """
+    fast = getattr(model, "compiled_multipliers", None)   # a System of one compiled beam and rigid bodies
+    out = fast(t, q, v) if callable(fast) else None
+    if out is not None:
+        return out
     n = q.size
     r0 = np.asarray(model.residual(t, q, v, np.zeros(n)), dtype=float)
     _, gamma = model.constraint_rates(t, q, v)

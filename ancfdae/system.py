@@ -9,6 +9,7 @@ given (:mod:`ancfdae.joints`). The equations are ``r(t, q, v, a) + G^T lam = 0``
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
@@ -20,6 +21,10 @@ from ancfdae.joints.base import Frame, Joint
 from ancfdae.joints.rows import Affine, Rows
 from ancfdae.problem import capabilities
 from ancfdae.system_stack import BodyStack
+
+if TYPE_CHECKING:
+    from ancfdae.joints.assembled_numba import CompiledConstraintSet
+    from ancfdae.system_compiled import SystemArrays
 
 __all__ = ["System"]
 
@@ -111,6 +116,7 @@ class System(BodyStack):
             from ancfdae.joints.assembled_numba import CompiledConstraintSet
             self._joint_set = CompiledConstraintSet(rows)
         self._body_rows = body_rows   # the bodies whose rows are evaluated body by body
+        self._compiled = None         # (SystemArrays or None,), made at the first use of compiled_arrays
         if self.n_constraints:
             drop = dependent_rows(self.constraint_jacobian(t0, q0))
             if drop:
@@ -165,6 +171,27 @@ class System(BodyStack):
         if not self._body_rows and hasattr(self._joint_set, "terms_at"):
             return self._joint_set.terms_at(t)
         return lambda q, lam: (self.constraints(t, q), self.constraint_force(t, q, lam))
+
+    @property
+    def compiled_rows(self) -> "CompiledConstraintSet | None":
+        """The one compiled set of every constraint row (:class:`~ancfdae.joints.assembled_numba.CompiledConstraintSet`,
+        the bodies' rows first), or None when some rows are evaluated body by body or by the NumPy reference."""
+        return self._joint_set if not self._body_rows and hasattr(self._joint_set, "terms_at") else None
+
+    @property
+    def compiled_arrays(self) -> "SystemArrays | None":
+        """The system as flat arrays for compiled steps and reactions
+        (:class:`ancfdae.system_compiled.SystemArrays`, made once), or None when it has no compiled form."""
+        if self._compiled is None:
+            from ancfdae.system_compiled import SystemArrays
+            self._compiled = (SystemArrays.of(self),)
+        return self._compiled[0]
+
+    def compiled_multipliers(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """``(a, lam)`` at ``(t, q, v)`` in one compiled call (:meth:`ancfdae.system_compiled.SystemArrays.multipliers`,
+        the fast path of :func:`ancfdae.constrained.multipliers`), or None when the system has no compiled form."""
+        arrays = self.compiled_arrays
+        return None if arrays is None else arrays.multipliers(t, q, v)
 
     def constraint_position_terms_at(self, t: float) -> Callable[[np.ndarray], tuple]:
         """``q -> (g, G, g_t)`` at the time ``t`` (a GGL stage's rows): one compiled pass when every row is

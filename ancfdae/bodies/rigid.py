@@ -176,6 +176,14 @@ class RigidBody:
         f, _ = self._loads.nonconservative(t, q)
         return self._M @ a - f - self._loads.gravity
 
+    def residual_parts(self) -> tuple[np.ndarray, np.ndarray, list, list]:
+        """``(M, f_g, forces, moments)`` of :meth:`residual`: the dense mass matrix, gravity's generalised force,
+        ``[(time, f)]`` and ``[(time, C)]`` with ``f_ext(t, q) = sum time(t) f + (sum time(t) C) q`` (copies;
+        what a compiled step of a System evaluates, :mod:`ancfdae.integrators._index3_steps`)."""
+        lo = self._loads
+        return (self._M.copy(), lo.gravity.copy(), [(tm, f.copy()) for tm, f in lo.forces],
+                [(tm, C.copy()) for tm, C in lo.moments])
+
     def jacobian(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> JacobianBlocks:
         """Exact ``dr/dq = -df_ext/dq`` (moments only), ``dr/dv = 0``, ``dr/da = M``, on one full pattern."""
         return self.residual_jacobian(t, q, v, a)[1]

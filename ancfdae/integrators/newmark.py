@@ -43,6 +43,7 @@ from ancfdae.integrators._alpha_index3 import index3_step, mass_scale
 from ancfdae.kkt import KKTAssembler
 from ancfdae.integrators._alpha_iteration import AlphaIteration
 from ancfdae.integrators._alpha_steps import AlphaSteps
+from ancfdae.integrators._index3_steps import Index3Steps
 from ancfdae.integrators._newton_records import NewtonOptions
 from ancfdae.integrators.driver import consistent_acceleration
 from ancfdae.integrators.newton_stepper import NewtonStepper
@@ -70,7 +71,7 @@ class _AlphaFamily(NewtonStepper):
         super().__init__(model, h, newton=newton)
         self.beta, self.gamma, self.alpha_m, self.alpha_f = beta, gamma, alpha_m, alpha_f
         self._offer = (None, None)   # (model, its compiled_residual), taken at the first step of a run
-        self._steps = (None, None)   # (model, its AlphaSteps or None), made at the first steps_until of a run
+        self._steps = (None, None)   # (model, its AlphaSteps or Index3Steps or None), made at the first steps_until
 
     def options(self) -> dict:
         """The options as a JSON-able dict (stored in the Result).
@@ -169,7 +170,8 @@ class _AlphaFamily(NewtonStepper):
         (:mod:`ancfdae.integrators._alpha_steps`). Of the steps taken, all but the last are accepted
         here; the last one's outcome is returned for the driver to accept, as from :meth:`step` (a
         failure: the step after the accepted ones failed). Without the compiled path (a user's model,
-        point moments, constraints, full Newton, no cached banded factors yet) it is one :meth:`step`.
+        point moments, full Newton, no cached banded factors yet; constrained: a model other than a System of
+        one compiled beam and rigid bodies, :mod:`ancfdae.integrators._index3_steps`) it is one :meth:`step`.
 
         Parameters
         ----------
@@ -186,6 +188,8 @@ class _AlphaFamily(NewtonStepper):
             Steps accepted here before it.
         """
         steps = self._compiled_steps()
+        if self._constrained:
+            return steps.run(float(t_stop), int(max_count)) if steps is not None and max_count >= 1 else (self.step(), 0)
         lu = self.newton._lu
         band = getattr(lu, "_lu", None)
         if (steps is None or max_count < 1 or self._h_matrix is None or getattr(band, "lub", None) is None
@@ -194,10 +198,15 @@ class _AlphaFamily(NewtonStepper):
         return steps.run(band, float(t_stop), int(max_count))
 
     def _compiled_steps(self):
-        """The model's compiled steps (:class:`._alpha_steps.AlphaSteps`) for this run, or None."""
-        if self._constrained or self.newton.options.jacobian != "modified":
+        """The model's compiled steps for this run (:class:`._alpha_steps.AlphaSteps`; constrained:
+        :class:`._index3_steps.Index3Steps`), or None."""
+        if self.newton.options.jacobian != "modified":
             return None
         model = self.model.wrapped
+        if self._constrained:
+            if self._steps[0] is not model:
+                self._steps = (model, Index3Steps.offer(self))
+            return self._steps[1]
         if self._steps[0] is not model:
             offer = getattr(model, "compiled_residual", None)
             compiled = offer() if offer is not None else None

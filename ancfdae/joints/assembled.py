@@ -120,6 +120,21 @@ class ConstraintSet:
             w[:, j + 1] = ph
         return w
 
+    def weight_table(self, times: np.ndarray, derivatives: bool = False) -> np.ndarray:
+        """Row 0 of :meth:`weights` at each of ``times``, shape (k, 1 + number of timed terms); with
+        ``derivatives`` every row, (k, 3, 1 + number of timed terms).
+
+        A time function that offers ``table(times) -> (k, 3)`` (:class:`~ancfdae.joints.Prescribed`'s: one call of
+        the user's function per time, shared by its terms) is evaluated through it; any other at each time."""
+        times = np.asarray(times, dtype=float)
+        w = np.zeros((times.size, 3, 1 + len(self.timed)))
+        w[:, 0, 0] = 1.0
+        for j, (phi, _, _) in enumerate(self.timed):
+            table = getattr(phi, "table", None)
+            w[:, :, j + 1] = (table(times) if table is not None
+                              else [np.asarray(phi(t), dtype=float).reshape(3) for t in times])
+        return w if derivatives else np.ascontiguousarray(w[:, 0])
+
     # -- evaluation ----------------------------------------------------------------------------
     def _csr(self, pattern, data):
         return sp.csr_matrix((data, pattern.indices, pattern.indptr), shape=pattern.shape)

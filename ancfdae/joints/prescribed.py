@@ -33,15 +33,69 @@ def _checked(arg, fn, size):
 
 
 class _Cached:
-    """One evaluation of a time function per time, shared by the rows' terms."""
+    """One evaluation of a time function per time, shared by the rows' terms; :meth:`table` evaluates it at
+    many times at once (the compiled index-3 steps take the rows' weights of their coming steps as a table)."""
 
-    def __init__(self, fn):
-        self.fn, self.t, self.value = fn, None, None
+    def __init__(self, fn, raw, size):
+        self.fn, self.raw, self.size, self.t, self.value = fn, raw, size, None, None
+        self._times, self._table = None, None
 
     def __call__(self, t):
         if t != self.t:
             self.value, self.t = self.fn(t), t
         return self.value
+
+    def table(self, times: np.ndarray) -> np.ndarray:
+        """``(k, 3, size)``: value and two derivatives at each of ``times`` (kept for the same array object).
+
+        One call of the user's function per time and one check of the whole table; a table that fails the
+        check is evaluated again through the checked call, which names the time and the fault."""
+        if times is not self._times:
+            try:
+                tab = np.array([self.raw(t) for t in times], dtype=float)
+            except (TypeError, ValueError):
+                tab = None
+            if tab is not None and self.size == 1 and tab.shape == (times.size, 3):
+                tab = tab[:, :, None]
+            if tab is None or tab.shape != (times.size, 3, self.size) or not np.all(np.isfinite(tab)):
+                tab = np.array([self.fn(t) for t in times], dtype=float).reshape(times.size, 3, self.size)
+            self._times, self._table = times, tab
+        return self._table
+
+
+class _Component:
+    """``phi(t)`` of the ``k``-th coordinate of a prescribed position (and its table of values)."""
+
+    def __init__(self, p: _Cached, k: int) -> None:
+        self.p, self.k = p, k
+
+    def __call__(self, t):
+        return tuple(x[self.k] for x in self.p(t))
+
+    def table(self, times: np.ndarray) -> np.ndarray:
+        """``phi`` and its two derivatives at each of ``times``, (k, 3)."""
+        return self.p.table(times)[:, :, self.k]
+
+
+class _AngleTerm:
+    """``-sin th(t)`` (``cos=False``) or ``cos th(t)`` with two derivatives: the slope-direction row's factors."""
+
+    def __init__(self, th: _Cached, cos: bool) -> None:
+        self.th, self.cos = th, cos
+
+    def __call__(self, t):
+        a, w, al = (x[0] for x in self.th(t))
+        if self.cos:
+            return np.cos(a), -np.sin(a) * w, -np.cos(a) * w * w - np.sin(a) * al
+        return -np.sin(a), -np.cos(a) * w, np.sin(a) * w * w - np.cos(a) * al
+
+    def table(self, times: np.ndarray) -> np.ndarray:
+        """``phi`` and its two derivatives at each of ``times``, (k, 3) (the expressions of ``__call__``)."""
+        tab = self.th.table(times)[:, :, 0]
+        a, w, al = tab[:, 0], tab[:, 1], tab[:, 2]
+        if self.cos:
+            return np.column_stack((np.cos(a), -np.sin(a) * w, -np.cos(a) * w * w - np.sin(a) * al))
+        return np.column_stack((-np.sin(a), -np.cos(a) * w, np.sin(a) * w * w - np.cos(a) * al))
 
 
 class Prescribed(Joint):
@@ -85,25 +139,16 @@ class Prescribed(Joint):
         rows = Rows(n)
         if self.position is not None:
             idx = linear(rows, f"{label}.r", f.point)
-            p = _Cached(_checked("position", self.position, dim))
+            p = _Cached(_checked("position", self.position, dim), self.position, dim)
             for k, i in enumerate(idx):
-                rows.add_timed([i], TimedTerm(lambda t, k=k: tuple(x[k] for x in p(t)),
-                                              sp.csr_matrix((1, n)), np.array([-1.0])))
+                rows.add_timed([i], TimedTerm(_Component(p, k), sp.csr_matrix((1, n)), np.array([-1.0])))
         if self.angle is not None:
             if dim != 2:
                 raise ValueError(f"{label}: `angle` drives a planar slope; a {dim}D body needs `position` only.")
             d = axis(f, "axis", self.axis)
-            th = _Cached(_checked("angle", self.angle, 1))
+            th = _Cached(_checked("angle", self.angle, 1), self.angle, 1)
             i = rows.add(f"{label}.angle", sp.csr_matrix((1, n)), 0.0)
             X = sp.csr_matrix(d.X)
-
-            def minus_sin(t):
-                a, w, al = (x[0] for x in th(t))
-                return -np.sin(a), -np.cos(a) * w, np.sin(a) * w * w - np.cos(a) * al
-
-            def cos(t):
-                a, w, al = (x[0] for x in th(t))
-                return np.cos(a), -np.sin(a) * w, -np.cos(a) * w * w - np.sin(a) * al
-            rows.add_timed([i], TimedTerm(minus_sin, X[0], d.x0[:1]))
-            rows.add_timed([i], TimedTerm(cos, X[1], d.x0[1:]))
+            rows.add_timed([i], TimedTerm(_AngleTerm(th, False), X[0], d.x0[:1]))
+            rows.add_timed([i], TimedTerm(_AngleTerm(th, True), X[1], d.x0[1:]))
         return rows

@@ -44,6 +44,12 @@ class CompiledResidual:
         Gravity's free force vector.
     dead : ndarray (m, n_dof)
         The dead loads' free force vectors, ``dead_times`` their time functions (in the loads' order).
+    index3_steps : numba dispatcher or None
+        The element's entry point of whole index-3 steps of a System holding the beam (contract in
+        :mod:`ancfdae.integrators._index3_steps_numba`), if any.
+    multipliers : numba dispatcher or None
+        The element's entry point of a System's reactions at an output time
+        (:func:`ancfdae.integrators._index3_steps_numba.system_multipliers`), if any.
     """
 
     iterations: Callable
@@ -55,6 +61,8 @@ class CompiledResidual:
     gravity: np.ndarray | None = None
     dead: np.ndarray | None = None
     dead_times: tuple = ()
+    index3_steps: Callable | None = None
+    multipliers: Callable | None = None
 
 
 # the beam is named, not imported: beam.py imports this module
@@ -74,8 +82,12 @@ def compiled_residual(beam: "ancfdae.models.Beam") -> CompiledResidual | None:
     m = beam._M_csr   # the mass without its stored zeros (Assembler.product_csr)
     arrays = (beam._q_fixed, beam._gather, asm._vec_all, asm._slot_all, m.data, m.indptr, m.indices)
     steps = getattr(beam.element.kernels, "alpha_steps", None)
+    index3 = getattr(beam.element.kernels, "index3_steps", None)
+    reactions = getattr(beam.element.kernels, "multipliers", None)
     dead = np.array([vec for _, vec in loads.dead], dtype=float).reshape(len(loads.dead), loads.n_dof)
     return CompiledResidual(fn, arrays, tuple(element_args), external, float(beam.load_factor),
                             steps(beam.geom)[0] if steps is not None else None,
                             np.ascontiguousarray(loads.gravity, dtype=float), np.ascontiguousarray(dead),
-                            tuple(time for time, _ in loads.dead))
+                            tuple(time for time, _ in loads.dead),
+                            index3(beam.geom)[0] if index3 is not None else None,
+                            reactions(beam.geom)[0] if reactions is not None else None)

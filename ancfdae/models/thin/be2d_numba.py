@@ -20,10 +20,11 @@ from ...integrators._affine import affine3
 from ..beam.iteration_numba import alpha_finish, alpha_update, carry_on
 from ...integrators._alpha_steps_numba import alpha_steps
 from ..beam.static_numba import static_newton
+from ...integrators._index3_steps_numba import index3_steps, system_multipliers
 from ..element import Kernel
 
 __all__ = ["BE2DCompiled", "be2d_forces", "be2d_fused", "be2d_alpha_iterations", "be2d_alpha_steps",
-           "be2d_static_newton", "STRUCTURAL", "CONTINUUM"]
+           "be2d_static_newton", "be2d_index3_steps", "be2d_multipliers", "STRUCTURAL", "CONTINUUM"]
 
 STRUCTURAL, CONTINUUM = 0, 1
 
@@ -256,6 +257,20 @@ def be2d_static_newton(x, r, f_ext, fpar, ipar, flat, ab, piv, kdata, rbuf, arra
     return static_newton(be2d_fused, x, r, f_ext, fpar, ipar, flat, ab, piv, kdata, rbuf, arrays, element_args)
 
 
+@njit(cache=True)
+def be2d_index3_steps(S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv, W, E, cons, rigid, beam, element_args):
+    """Index-3 steps of a System holding a BE2D beam in one call (contract in
+    :mod:`ancfdae.integrators._index3_steps_numba`)."""
+    index3_steps(be2d_fused, S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv, W, E, cons, rigid, beam,
+                 element_args)
+
+
+@njit(cache=True)
+def be2d_multipliers(W, ext, q, v, a, lam, cons, rigid, beam, element_args, load_factor):
+    """A System's ``(a, lam)`` at an output time in one call (:func:`ancfdae.integrators._index3_steps_numba.system_multipliers`)."""
+    system_multipliers(be2d_fused, W, ext, q, v, a, lam, cons, rigid, beam, element_args, load_factor)
+
+
 class BE2DCompiled(Kernel):
     """The compiled kernel object of BE2D: :func:`be2d_forces` and the fused entry point :func:`be2d_fused`."""
 
@@ -294,3 +309,11 @@ class BE2DCompiled(Kernel):
     def static_newton(self, geom: dict) -> tuple:
         """``(be2d_static_newton, args)``: a load step's static full Newton (:mod:`ancfdae.models.beam.static_numba`)."""
         return be2d_static_newton, self._args(geom)
+
+    def index3_steps(self, geom: dict) -> tuple:
+        """``(be2d_index3_steps, args)``: whole index-3 steps of a System (:mod:`ancfdae.integrators._index3_steps_numba`)."""
+        return be2d_index3_steps, self._args(geom)
+
+    def multipliers(self, geom: dict) -> tuple:
+        """``(be2d_multipliers, args)``: a System's reactions at an output time (:mod:`ancfdae.system_compiled`)."""
+        return be2d_multipliers, self._args(geom)

@@ -1,0 +1,372 @@
+"""Whole index-3 steps of the Newmark family on a System, as one compiled call (needs numba).
+
+The compiled twin of :func:`ancfdae.integrators._alpha_index3.index3_step` with the modified Newton of
+:class:`ancfdae.integrators._newton.NewtonSolver`, for a :class:`ancfdae.System` of one beam whose element
+offers a fused kernel and any number of rigid bodies, every constraint row folded into the compiled set
+(:mod:`ancfdae.joints.assembled_numba`). Per Newton iteration: the substitution with the cached factors, the
+update of ``x = [y, mu]``, the step's states, the beam's fused residual and ``+ M a - lambda f_ext``, the rigid
+bodies' ``M a - f(t, q) - f_g``, ``(g, G^T lam)`` in one pass, the norms and the solver's decisions. A refresh
+assembles the KKT matrix ``[[K + s M + H(lam), sm G^T], [sm G, 0]]`` densely (the beam's tangent from its
+fused kernel, ``H`` and ``G`` on their fixed patterns) and factorises it with partial pivoting
+(:func:`dense_lu`); the round-off floor is the Python path's. The entry point::
+
+    steps(S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv, W, E, cons, rigid, beam, element_args)
+
+* ``S`` (4, n): ``q, v, a, ah`` (``ah`` the algorithmic acceleration) at ``fpar[T]`` on entry, the state
+  reached on return; ``P`` (4, n) the state before the last step taken; ``L`` (2, m): the multipliers
+  reached and those before the last step.
+* ``LU, piv``: a dense factorisation (written at each refresh), ``LUs, pivs`` its copy at the start of a
+  step that refreshed; ``lub, bpiv``: LAPACK's banded factors the Python path left (``ipar[KIND] = BAND``).
+* ``W`` (k, nw): per coming step, the time weights at its end (the constraint terms' row 0 of
+  :meth:`~ancfdae.joints.assembled.ConstraintSet.weights`, then the rigid bodies' load factors); ``E``
+  (k or 1, nb): the beam's external force at each step's end (one row: constant).
+* ``cons``, ``rigid``, ``beam``: the arrays of :class:`ancfdae.integrators._index3_steps.Index3Steps`.
+
+Status ``STOPPED`` (the last step reached ``t_stop`` or the end, or ``max_count`` steps were taken) or
+``NEEDS_PYTHON``: the next step needs a decision of Python (a non-finite value, a failed attempt that the
+solver retries, ``max_iter``); ``S``, the factors (restored) and the floor are those before it, none of its
+work is counted, and the Python step redoes it. As in :mod:`._alpha_steps_numba`, the loop is inlined into
+the element's one-line entry point (numba caches a function on disk only when the kernel it calls is a
+compile-time constant); after editing this module delete the element's cached ``*index3_steps*`` files.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ancfdae.integrators._linsolve_numba import band_solve
+from ancfdae.integrators._newton import max_abs
+from ancfdae.joints.assembled_numba import _g_force, _rates
+from ancfdae.models.beam.assembly_numba import finish_residual
+
+__all__ = ["index3_steps", "system_multipliers", "dense_lu", "dense_solve"]
+
+# fpar
+T0, H, T, T_BOUND, T_STOP, H_MATRIX, BETA, GAMMA, ALPHA_M, ALPHA_F, TOL, ATOL, FLOOR, CONTRACTION, GRID_TOL, \
+    T_PREV, MSCALE, XTOL, LOAD_FACTOR, FLOOR_FACTOR = range(20)
+N_FPAR = 20
+# ipar
+N_STEPS, MAX_COUNT, MAX_ITER, KIND, HAVE_H, KL, KU = range(7)
+N_IPAR = 7
+# ipar[KIND]
+NONE, DENSE, BAND = 0, 1, 2
+# out
+DONE, STATUS, ITERATIONS, RESIDUALS, JACOBIANS = range(5)
+N_OUT = 5
+STOPPED, NEEDS_PYTHON = 0, 1
+
+
+@njit(cache=True, error_model="numpy")   # a zero pivot gives inf/nan, as LAPACK does
+def dense_lu(A, piv):
+    """``A = P L U`` in place (row-major Doolittle with partial pivoting, LAPACK's ``getrf`` convention:
+    row ``k`` was swapped with row ``piv[k]``)."""
+    n = A.shape[0]
+    for k in range(n):
+        p, big = k, abs(A[k, k])
+        for i in range(k + 1, n):
+            if abs(A[i, k]) > big:
+                p, big = i, abs(A[i, k])
+        piv[k] = p
+        if p != k:
+            for j in range(n):
+                A[k, j], A[p, j] = A[p, j], A[k, j]
+        d = A[k, k]
+        for i in range(k + 1, n):
+            lik = A[i, k] / d
+            A[i, k] = lik
+            if lik != 0.0:
+                for j in range(k + 1, n):
+                    A[i, j] -= lik * A[k, j]
+
+
+@njit(cache=True, error_model="numpy")
+def dense_solve(LU, piv, b):
+    """Solve ``A x = b`` in place in ``b`` with the factors of :func:`dense_lu`."""
+    n = b.size
+    for k in range(n):
+        p = piv[k]
+        if p != k:
+            b[k], b[p] = b[p], b[k]
+    for i in range(n):
+        s = b[i]
+        for j in range(i):
+            s -= LU[i, j] * b[j]
+        b[i] = s
+    for i in range(n - 1, -1, -1):
+        s = b[i]
+        for j in range(i + 1, n):
+            s -= LU[i, j] * b[j]
+        b[i] = s / LU[i, i]
+
+
+@njit(cache=True)
+def _rigid_residual(r, q, a, w, rigid):
+    """``r_i = (M a)_i - f_i(t, q) - f_g,i`` on the rigid bodies' coordinates (``RigidBody.residual``)."""
+    ridx, mi, mj, mv, grav, fvec, fcol, ci, cj, cv, ccol = rigid
+    f = np.zeros(r.size)
+    ma = np.zeros(r.size)
+    for k in range(fcol.size):
+        s = w[fcol[k]]
+        for i in ridx:
+            f[i] += s * fvec[k, i]
+    for e in range(ci.size):
+        f[ci[e]] += w[ccol[e]] * cv[e] * q[cj[e]]
+    for e in range(mi.size):
+        ma[mi[e]] += mv[e] * a[mj[e]]
+    for i in ridx:
+        r[i] = (ma[i] - f[i]) - grav[i]
+
+
+@njit(inline="always")
+def _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid, beam, eargs, rbuf, kbuf):
+    """The step's residual ``[r(t1, q1, v1, a1) + G^T lam; sm g]`` at ``x`` into ``r``; returns ``(max|r|, q1)``."""
+    ob, nb, q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices = beam
+    q, v, a, lam = np.empty(n), np.empty(n), np.empty(n), np.empty(m)
+    for i in range(n):
+        y = x[i]
+        q[i] = qp[i] + y
+        v[i] = vp[i] + c_v * y
+        a[i] = s * y + ca[i]
+    for i in range(m):
+        lam[i] = sm * x[n + i]
+    fused(q[ob:ob + nb], q_fixed, gather, vec_slot, mat_slot, False, rbuf, kbuf, *eargs)
+    finish_residual(rbuf, m_data, indptr, indices, a[ob:ob + nb], lf, ext)
+    _rigid_residual(r, q, a, w, rigid)
+    for i in range(nb):
+        r[ob + i] = rbuf[i]
+    g, f = np.empty(m), np.empty(n)
+    lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa = cons[:11]
+    _g_force(w, lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa, q, lam, g, f)
+    for i in range(n):
+        r[i] = r[i] + f[i]
+    for i in range(m):
+        r[n + i] = sm * g[i]
+    return max_abs(r), q
+
+
+@njit(inline="always")
+def _matrix(fused, A, x, q, n, m, s, sm, w, cons, rigid, beam, eargs, rbuf, kbuf):
+    """The KKT matrix at ``x`` (state ``q``) into ``A`` (dense); returns ``max(max|K|, max|sm G|)``."""
+    ob, nb, q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices = beam
+    lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa, ls, qslot, g_indptr, g_indices = cons
+    ridx, mi, mj, mv, grav, fvec, fcol, ci, cj, cvv, ccol = rigid
+    A[:, :] = 0.0
+    fused(q[ob:ob + nb], q_fixed, gather, vec_slot, mat_slot, True, rbuf, kbuf, *eargs)
+    kmax = 0.0
+    for i in range(nb):
+        for jj in range(indptr[i], indptr[i + 1]):
+            A[ob + i, ob + indices[jj]] += kbuf[jj] + s * m_data[jj]
+            kmax = max(kmax, abs(kbuf[jj]))
+    for e in range(mi.size):
+        A[mi[e], mj[e]] += s * mv[e]
+    for e in range(ci.size):
+        k = -(w[ccol[e]] * cvv[e])
+        A[ci[e], cj[e]] += k
+        kmax = max(kmax, abs(k))
+    lam = np.empty(m)
+    for i in range(m):
+        lam[i] = sm * x[n + i]
+    for e in range(qi.size):   # H(lam) = sum_i lam_i A_i
+        A[qj[e], qk[e]] += qa[e] * lam[qi[e]]
+    gdata = np.zeros(g_indices.size)
+    for e in range(lt.size):
+        gdata[ls[e]] += w[lt[e]] * lv[e]
+    for e in range(qi.size):
+        gdata[qslot[e]] += qa[e] * q[qk[e]]
+    gmax = 0.0
+    for i in range(m):
+        for jj in range(g_indptr[i], g_indptr[i + 1]):
+            val = sm * gdata[jj]
+            A[n + i, g_indices[jj]] += val
+            A[g_indices[jj], n + i] += val
+            gmax = max(gmax, abs(val))
+    return kmax, gmax
+
+
+@njit(inline="always")
+def index3_steps(fused, S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv, W, E, cons, rigid, beam, eargs):
+    """Index-3 steps until ``t_stop``, the end, ``max_count`` steps or a decision for Python (module docstring)."""
+    n, m = S.shape[1], L.shape[1]
+    N = n + m
+    nb = beam[1]
+    t0, h, t_bound, t_stop = fpar[T0], fpar[H], fpar[T_BOUND], fpar[T_STOP]
+    beta, gamma, am, af = fpar[BETA], fpar[GAMMA], fpar[ALPHA_M], fpar[ALPHA_F]
+    tol, atol, contraction, grid_tol = fpar[TOL], fpar[ATOL], fpar[CONTRACTION], fpar[GRID_TOL]
+    mscale, xtol, lf, ffac = fpar[MSCALE], fpar[XTOL], fpar[LOAD_FACTOR], fpar[FLOOR_FACTOR]
+    n_steps, max_count, max_iter = ipar[N_STEPS], min(ipar[MAX_COUNT], W.shape[0]), ipar[MAX_ITER]
+    kind, kl, ku = ipar[KIND], ipar[KL], ipar[KU]
+    have_h, h_matrix, floor = ipar[HAVE_H], fpar[H_MATRIX], fpar[FLOOR]
+    A = np.empty((N, N))
+    x, r, dx = np.empty(N), np.empty(N), np.empty(N)
+    rbuf, kbuf = np.empty(nb + 1), np.empty(beam[6].size + 1)
+    qp, vp, ca = np.empty(n), np.empty(n), np.empty(n)
+    t = fpar[T]
+    done, iters, evals, jacs, status = 0, 0, 0, 0, NEEDS_PYTHON
+    eps = np.finfo(np.float64).eps
+    while done < max_count:
+        t_new = t0 + (n_steps + done + 1) * h
+        if t_new >= t_bound - grid_tol * h:
+            t_new = t_bound
+        hs = t_new - t
+        # NewtonStepper.step: a new step size drops the matrix
+        kind0, floor0, have_h0, h_matrix0 = kind, floor, have_h, h_matrix
+        if have_h == 0 or abs(hs - h_matrix) > 1e-8 * h:
+            kind, have_h, h_matrix = NONE, 1, hs
+        # index3_equations
+        w = W[done]
+        ext = E[done] if E.shape[0] > 1 else E[0]
+        s = (1.0 - am) / ((1.0 - af) * beta * hs * hs)
+        sm = s * mscale
+        c_v = gamma / (beta * hs)
+        cx = beta * hs * hs
+        for i in range(n):
+            ah0 = S[3, i]
+            qp[i] = S[0, i] + hs * S[1, i] + (hs * hs * (0.5 - beta)) * ah0
+            vp[i] = S[1, i] + (hs * (1.0 - gamma)) * ah0
+            ca[i] = (am * ah0 - af * S[2, i]) / (1.0 - af)
+            x[i] = cx * ah0
+        for i in range(m):
+            x[n + i] = L[0, i] / sm
+        # NewtonSolver.solve and _attempt (modified Newton)
+        err, q = _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid, beam, eargs,
+                           rbuf, kbuf)
+        its, ev, jc, saved = 0, 1, 0, False
+        ok = np.isfinite(err)
+        if ok:
+            rel = max(tol * err, atol)
+            threshold = max(rel, floor)
+            converged = err <= threshold
+            fresh, diverging, k = False, 0, 0
+            while not converged and k < max_iter:
+                k += 1
+                if kind == NONE:
+                    if kind0 == DENSE and not saved:   # kept to restore if Python must redo the step
+                        LUs[:, :] = LU
+                        pivs[:] = piv
+                        saved = True
+                    kmax, gmax = _matrix(fused, A, x, q, n, m, s, sm, w, cons, rigid, beam, eargs, rbuf, kbuf)
+                    qm = max(1.0, max_abs(q))
+                    floor = max(floor, max(ffac * eps * kmax * qm, ffac * eps * gmax * qm))
+                    LU[:, :] = A
+                    dense_lu(LU, piv)
+                    kind, fresh, jc = DENSE, True, jc + 1
+                    threshold = max(rel, floor)
+                dx[:] = r
+                if kind == DENSE:
+                    dense_solve(LU, piv, dx)
+                else:
+                    band_solve(lub, kl, ku, bpiv, dx)
+                its += 1
+                dx_max = max_abs(dx)
+                if not np.isfinite(dx_max):
+                    ok = False
+                    break
+                for i in range(N):
+                    x[i] = x[i] - dx[i]
+                err_new, q = _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid, beam,
+                                       eargs, rbuf, kbuf)
+                ev += 1
+                if not np.isfinite(err_new):
+                    ok = False
+                    break
+                stagnant = (err_new > threshold and fresh and err_new > 0.5 * err
+                            and dx_max <= xtol * max(1.0, max_abs(x)))
+                if err_new <= threshold or stagnant:
+                    converged = True
+                    break
+                rate = err_new / err if err > 0 else np.inf
+                err = err_new
+                if rate > contraction:
+                    if fresh and rate >= 1.0:
+                        diverging += 1
+                        if diverging >= 2:
+                            ok = False
+                            break
+                    else:
+                        diverging = 0
+                    kind = NONE
+                else:
+                    diverging = 0
+            ok = ok and converged
+        if ok:
+            for i in range(n):
+                y = x[i]
+                if not (np.isfinite(qp[i] + y) and np.isfinite(vp[i] + c_v * y)):
+                    ok = False
+        if not ok:   # Python redoes this step from its start: its state, factors and floor as they were
+            if saved:
+                LU[:, :] = LUs
+                piv[:] = pivs
+            kind, floor, have_h, h_matrix = kind0, floor0, have_h0, h_matrix0
+            break
+        P[:, :] = S
+        L[1, :] = L[0, :]
+        for i in range(n):
+            y = x[i]
+            S[0, i] = qp[i] + y
+            S[1, i] = vp[i] + c_v * y
+            S[2, i] = s * y + ca[i]
+            S[3, i] = y / cx
+        for i in range(m):
+            L[0, i] = sm * x[n + i]
+        iters += its
+        evals += ev
+        jacs += jc
+        done += 1
+        t_prev, t = t, t_new
+        fpar[T_PREV], fpar[T] = t_prev, t
+        if t >= t_bound or t_stop <= t + grid_tol * (t - t_prev):
+            status = STOPPED
+            break
+    if done == max_count:
+        status = STOPPED
+    fpar[FLOOR], fpar[H_MATRIX] = floor, h_matrix
+    ipar[KIND], ipar[HAVE_H] = kind, have_h
+    out[DONE], out[STATUS], out[ITERATIONS], out[RESIDUALS], out[JACOBIANS] = done, status, iters, evals, jacs
+
+
+@njit(inline="always")
+def system_multipliers(fused, W, ext, q, v, a_out, lam_out, cons, rigid, beam, eargs, lf):
+    """``(a, lam)`` from ``[[M, G^T], [G, 0]] [a; lam] = [-r(t, q, v, 0); gamma]`` (:func:`ancfdae.constrained.multipliers`)
+    into ``a_out``, ``lam_out``: ``W`` (3, nw) the time weights at ``t`` and their derivatives, ``ext`` the beam's
+    external force at ``t``, ``lf`` its load factor; a singular matrix gives non-finite values."""
+    n, m = q.size, lam_out.size
+    N = n + m
+    ob, nb, q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices = beam
+    lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa, ls, qslot, g_indptr, g_indices = cons
+    ridx, mi, mj, mv, grav, fvec, fcol, ci, cj, cvv, ccol = rigid
+    zero, r = np.zeros(n), np.zeros(n)
+    rbuf, kbuf = np.empty(nb + 1), np.empty(1)
+    fused(q[ob:ob + nb], q_fixed, gather, vec_slot, mat_slot, False, rbuf, kbuf, *eargs)
+    finish_residual(rbuf, m_data, indptr, indices, zero[ob:ob + nb], lf, ext)
+    _rigid_residual(r, q, zero, W[0], rigid)
+    for i in range(nb):
+        r[ob + i] = rbuf[i]
+    gt, gamma = np.empty(m), np.empty(m)
+    _rates(W[1], W[2], lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa, q, v, gt, gamma)
+    A, rhs = np.zeros((N, N)), np.empty(N)
+    for i in range(nb):
+        for jj in range(indptr[i], indptr[i + 1]):
+            A[ob + i, ob + indices[jj]] += m_data[jj]
+    for e in range(mi.size):
+        A[mi[e], mj[e]] += mv[e]
+    gdata = np.zeros(g_indices.size)
+    for e in range(lt.size):
+        gdata[ls[e]] += W[0, lt[e]] * lv[e]
+    for e in range(qi.size):
+        gdata[qslot[e]] += qa[e] * q[qk[e]]
+    for i in range(m):
+        for jj in range(g_indptr[i], g_indptr[i + 1]):
+            A[n + i, g_indices[jj]] += gdata[jj]
+            A[g_indices[jj], n + i] += gdata[jj]
+    for i in range(n):
+        rhs[i] = -r[i]
+    for i in range(m):
+        rhs[n + i] = gamma[i]
+    piv = np.empty(N, dtype=np.int64)
+    dense_lu(A, piv)
+    dense_solve(A, piv, rhs)
+    for i in range(n):
+        a_out[i] = rhs[i]
+    for i in range(m):
+        lam_out[i] = rhs[n + i]

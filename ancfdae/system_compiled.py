@@ -1,0 +1,175 @@
+"""A System's equations as flat arrays for compiled code: one compiled beam, rigid bodies, the compiled rows.
+
+:class:`SystemArrays` packs, once, what compiled loops need to evaluate a :class:`ancfdae.System` of one beam
+whose element offers compiled system entry points (BE2D: ``be2d_index3_steps``, ``be2d_multipliers``) and any
+number of rigid bodies, with every constraint row in the one compiled set (:attr:`ancfdae.System.compiled_rows`):
+
+* ``cons``: the rows' flat arrays (:class:`~ancfdae.joints.assembled.ConstraintSet`: linear entries, constants,
+  quadratic entries, their slots in ``G``'s pattern, that pattern);
+* ``rigid``: the rigid bodies' coordinates, mass entries, gravity, timed forces and timed moment matrices
+  (:meth:`ancfdae.bodies.rigid.RigidBody.residual_parts`) on the system's coordinates;
+* ``beam``: the beam's offset, size and fused-kernel arrays (:func:`ancfdae.models.beam.compiled.compiled_residual`).
+
+The time functions stay Python: :meth:`SystemArrays.weights` tabulates them at given times (the rows' weights,
+:meth:`~ancfdae.joints.assembled.ConstraintSet.weight_table`, then one column per rigid-body load) and
+:meth:`SystemArrays.external` the beam's external force. :meth:`SystemArrays.multipliers` is the compiled twin of
+:func:`ancfdae.constrained.multipliers` (the reactions at output times).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ancfdae.integrators._newton import max_abs
+
+__all__ = ["SystemArrays"]
+
+#: the compiled paths factorise the KKT matrix densely: offered up to this many unknowns ``n + m`` (B6's 62: LU
+#: 59 us, a solve 4.4 us, ``python -m benchmarks.index3_cost``; the LU grows as N^3, a banded one would be next)
+DENSE_MAX = 200
+
+
+def _coo(block: np.ndarray, offset: int):
+    i, j = np.nonzero(block)
+    return i + offset, j + offset, block[i, j]
+
+
+class SystemArrays:
+    """The flat arrays of a System (module docstring); use :meth:`of`.
+
+    Attributes
+    ----------
+    rows : CompiledConstraintSet
+    cons, rigid, beam : tuple
+        The arrays of the module docstring, in the order the compiled loops unpack them.
+    element_args : tuple
+        The beam element's kernel arguments.
+    compiled : CompiledResidual
+        The beam's offer (its ``index3_steps`` and ``multipliers`` entry points).
+    n_weights : int
+        Columns of :meth:`weights`.
+    """
+
+    def __init__(self, system, beam_at, compiled, rigid_bodies) -> None:
+        n = system.n_dof
+        rows = self.rows = system.compiled_rows
+        cons = (rows.lin_term, rows.lin_row, rows.lin_col, rows.lin_val, rows.const_term, rows.const_row,
+                rows.const_val, rows.qi, rows.qj, rows.qk, rows.qa, rows.lin_slot, rows._q_slot,
+                rows.G_pattern.indptr.astype(np.int64), rows.G_pattern.indices.astype(np.int64))
+        self.cons = tuple(np.ascontiguousarray(a) for a in cons)
+        n_w = 1 + len(rows.timed)
+        times, mi, mj, mv, ci, cj, cv, ccol, fvec, fcol = [], [], [], [], [], [], [], [], [], []
+        grav, ridx = np.zeros(n), []
+        for body, off in rigid_bodies:
+            M, fg, forces, moments = body.residual_parts()
+            nb = M.shape[0]
+            ridx.extend(range(off, off + nb))
+            for lst, arr in zip((mi, mj, mv), _coo(M, off)):
+                lst.append(arr)
+            grav[off:off + nb] = fg
+            for time, f in forces:
+                fv = np.zeros(n)
+                fv[off:off + nb] = f
+                fvec.append(fv)
+                fcol.append(n_w + len(times))
+                times.append(time)
+            for time, C in moments:
+                i, j, c = _coo(C, off)
+                ci.append(i)
+                cj.append(j)
+                cv.append(c)
+                ccol.append(np.full(i.size, n_w + len(times)))
+                times.append(time)
+        cat = (lambda x, dt: np.concatenate(x).astype(dt) if x else np.zeros(0, dt))
+        self.rigid = (np.array(ridx, dtype=np.int64), cat(mi, np.int64), cat(mj, np.int64), cat(mv, float), grav,
+                      np.array(fvec, dtype=float).reshape(len(fvec), n), np.array(fcol, dtype=np.int64),
+                      cat(ci, np.int64), cat(cj, np.int64), cat(cv, float), cat(ccol, np.int64))
+        self._times = times
+        self.n_weights = n_w + len(times)
+        beam, off = beam_at
+        q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices = compiled.arrays
+        self.beam = (int(off), int(beam.n_dof), q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices)
+        self.element_args = compiled.element_args
+        self.compiled, self._beam_model = compiled, beam
+        # the beam's external force: gravity alone is constant; dead loads need their time functions
+        self._dead = bool(compiled.dead_times)
+        self._E = np.ascontiguousarray(compiled.external(0.0)[None, :], dtype=float)
+        self._last = (np.zeros(0), np.zeros((0, 3, self.n_weights)))
+
+    @property
+    def load_factor(self) -> float:
+        """The beam's load factor now (read at each use: a static solve steps it)."""
+        return float(self._beam_model.load_factor)
+
+    @classmethod
+    def of(cls, system) -> "SystemArrays | None":
+        """The arrays of ``system``, or None when it is not such a System (module docstring) or has more than
+        :data:`DENSE_MAX` unknowns."""
+        if getattr(system, "compiled_rows", None) is None or not system.n_constraints:
+            return None
+        if system.n_dof + system.n_constraints > DENSE_MAX:
+            return None
+        beams, rigid = [], []
+        for body, off in zip(system.bodies, system.offsets):
+            offer = getattr(body, "compiled_residual", None)
+            if offer is not None:
+                compiled = offer()
+                if compiled is None or compiled.index3_steps is None or compiled.multipliers is None:
+                    return None
+                beams.append(((body, int(off)), compiled))
+            elif callable(getattr(body, "residual_parts", None)):
+                rigid.append((body, int(off)))
+            else:
+                return None
+        if len(beams) != 1:
+            return None
+        (beam_at, compiled), = beams
+        return cls(system, beam_at, compiled, rigid)
+
+    def weights(self, times: np.ndarray, derivatives: bool = False) -> np.ndarray:
+        """The time weights at ``times``: (k, n_weights), the rows' row 0 then the rigid loads' factors; with
+        ``derivatives`` (k, 3, n_weights), the rows' first and second derivatives in rows 1, 2 (the loads': 0).
+        The last table is kept: :meth:`multipliers` at one of its times reads it (an output time is a step's end).
+
+        Raises ValueError (naming the time and the fault) when a time function returns bad values."""
+        W = self.rows.weight_table(times, True)
+        if self._times:
+            extra = np.zeros((times.size, 3, len(self._times)))
+            extra[:, 0] = [[float(time(t)) for time in self._times] for t in times]
+            W = np.concatenate((W, extra), axis=-1)
+        self._last = (times, W)
+        return W if derivatives else np.ascontiguousarray(W[:, 0])
+
+    def _weights_at(self, t: float) -> np.ndarray:
+        """(3, n_weights) at ``t``: from the last table when ``t`` is one of its times, else evaluated."""
+        times, W = self._last
+        i = int(np.searchsorted(times, t)) if times.size else 0
+        if i < times.size and times[i] == t:
+            return W[i]
+        return self.weights(np.array([t]), True)[0]
+
+    def external(self, times: np.ndarray) -> np.ndarray:
+        """The beam's external force at ``times`` (k, nb), or its constant value (1, nb) without dead loads."""
+        if not self._dead:
+            return self._E
+        return np.ascontiguousarray([self.compiled.external(t) for t in times], dtype=float)
+
+    def multipliers(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(a, lam)`` at ``(t, q, v)`` as :func:`ancfdae.constrained.multipliers`, in one compiled call.
+
+        Raises
+        ------
+        numpy.linalg.LinAlgError
+            When the KKT solve gives non-finite values (a singular matrix).
+        """
+        W = np.ascontiguousarray(self._weights_at(float(t)))
+        n, m = q.size, self.rows.m
+        a, lam = np.empty(n), np.empty(m)
+        self.compiled.multipliers(W, self.external(np.array([float(t)]))[0], np.ascontiguousarray(q, dtype=float),
+                                  np.ascontiguousarray(v, dtype=float), a, lam, self.cons, self.rigid, self.beam,
+                                  self.element_args, self.load_factor)
+        if not (math.isfinite(max_abs(a)) and math.isfinite(max_abs(lam))):
+            raise np.linalg.LinAlgError(f"multipliers at t = {t:g}: the KKT solve gave non-finite values (singular "
+                                        "matrix? are constraints redundant (see ancfdae.constrained.dependent_rows)?)")
+        return a, lam

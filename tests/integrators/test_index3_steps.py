@@ -1,0 +1,131 @@
+"""The Newmark family's compiled index-3 steps of a System (one compiled beam and rigid bodies, the driver's
+``steps_until`` between output times: :mod:`ancfdae.integrators._index3_steps`) reach the Python path's states,
+multipliers and failures with the same counters.
+
+Catches: a step's work counted twice, not at all or counted when the step is handed back to Python (the counters
+must match); a decision of the solver skipped or taken differently (a refresh, the stagnation test: the counters
+differ); the predictor, the scaled multipliers, the algorithmic acceleration or the KKT matrix with a wrong
+coefficient (states or counters differ); the drives' time functions, the rigid bodies' timed forces and moments
+or the beam's dead loads at the wrong times or dropped (the loaded system below: states differ); the rigid
+bodies' gravity dropped; a failure inside the steps losing the outputs before it, its time or its reason; the
+drive's weight table differing from the time functions it tabulates, or a bad drive no longer named.
+"""
+import numpy as np
+import pytest
+
+from ancfdae import Gravity, Material, PointForce, PointMoment, RectangularSection, RigidBody, System, simulate
+from ancfdae.integrators import _index3_steps, newmark
+from ancfdae.joints import Prescribed, Spherical
+from ancfdae.models import BE2D, Beam
+from ancfdae.studies._multibody_models import slider_crank, spinup
+
+pytest.importorskip("numba")
+
+COUNTS = ("steps", "newton_iterations", "newton_solves", "residual_evals", "jacobian_evals", "factorizations",
+          "retries", "failed_solves")
+
+
+def _both(system, monkeypatch, t_end, method="generalized-alpha", **kw):
+    taken = []
+    run = _index3_steps.Index3Steps.run
+
+    def spy(self, *a):
+        out = run(self, *a)
+        taken.append(out[1])
+        return out
+    monkeypatch.setattr(_index3_steps.Index3Steps, "run", spy)
+    fast = simulate(system, (0.0, t_end), method, **kw)
+    monkeypatch.setattr(newmark._AlphaFamily, "steps_until", None)   # the driver's step-by-step loop
+    slow = simulate(system, (0.0, t_end), method, **kw)
+    monkeypatch.undo()
+    return fast, slow, sum(taken)
+
+
+#: largest difference from the Python path relative to the largest value: the dense LU rounds differently from
+#: LAPACK's banded one, so modified Newton's iterates differ at round-off and the converged steps within
+#: Newton's tolerance; the index-3 step divides ``q``'s share by ``beta h^2`` for ``a`` and ``lam``
+#: (measured on these runs: q 6e-14, v 2e-11, a 1e-6, lam 3e-9 relative, tol 1e-8)
+RTOL = {"q": 1e-11, "v": 1e-8, "a": 1e-5, "lam": 1e-6}
+
+
+def _same(fast, slow):
+    for key in COUNTS:
+        assert fast.stats[key] == slow.stats[key], key
+    np.testing.assert_array_equal(fast.t, slow.t)
+    for name in ("q", "v", "a", "lam"):
+        f, s = getattr(fast, name), getattr(slow, name)
+        assert f.shape == s.shape
+        assert np.abs(f - s).max() <= RTOL[name] * np.abs(s).max(), name
+
+
+@pytest.mark.parametrize("case, t_end, h, dt", [("b6", 0.03, 1e-4, 1e-3), ("b5", 1.5, 5e-3, 0.02)])
+def test_benchmarks_match_the_python_path(case, t_end, h, dt, monkeypatch):
+    b = slider_crank("BE2D", 8) if case == "b6" else spinup("BE2D", 8, w_s=4.0)
+    t_eval = np.linspace(0.0, t_end, int(round(t_end / dt)) + 1)
+    fast, slow, taken = _both(b.system, monkeypatch, t_end, h=h, rho_inf=0.9, t_eval=t_eval, newton={"tol": 1e-8})
+    assert fast.status == slow.status == "success"
+    _same(fast, slow)
+    # every step but the one handed to the driver at each output time was taken in the compiled call
+    assert taken == fast.stats["steps"] - (t_eval.size - 1)
+
+
+def _loaded(dead=True, force=lambda t: np.cos(20 * t), angle=lambda t: (np.array([2 * t * t]), np.array([4 * t]),
+                                                                         np.array([4.0]))):
+    """A beam pinned to the ground whose tip holds a rigid body with gravity, a timed force and a timed moment;
+    the beam carries gravity and (``dead``) a timed dead load; its root angle is driven by ``angle``."""
+    el = BE2D(Material(2.0e9, 0.3, 1200.0), RectangularSection(0.02))
+    loads = [Gravity((0.0, -9.81))] + ([PointForce((0.0, 3.0), node=4, time=lambda t: np.sin(30 * t))] if dead else [])
+    beam = Beam(el, 6, 0.6, loads=loads)
+    body = RigidBody(0.3, 2e-4, [0.6, 0.0], com=[0.05, 0.0], loads=[
+        Gravity((0.0, -9.81)), PointForce((2.0, -1.0), node=0, time=force),
+        PointMoment(0.4, node=0, time=lambda t: 1.0 + t)])
+    drive = Prescribed((beam, 0), position=lambda t: (np.zeros(2), np.zeros(2), np.zeros(2)),
+                       angle=angle)
+    return System([beam, body], [drive, Spherical((beam, -1), (body, (0.0, 0.0)))])
+
+
+@pytest.mark.parametrize("dead, method, opts", [(True, "generalized-alpha", {"rho_inf": 0.8}),
+                                                (False, "generalized-alpha", {"rho_inf": 0.8}),
+                                                (True, "hht", {"alpha": 0.1}), (True, "newmark", {"beta": 0.3025, "gamma": 0.6})])
+def test_loaded_system_matches_the_python_path(dead, method, opts, monkeypatch):
+    # t_end off the output grid and off the step grid: a shortened last step (a new matrix in the compiled call)
+    t_eval = [0.0, 0.01, 0.0155, 0.03, 0.0405]
+    fast, slow, taken = _both(_loaded(dead), monkeypatch, 0.0405, method, h=5e-4, t_eval=t_eval,
+                              newton={"tol": 1e-10, "contraction": 0.2}, **opts)
+    assert fast.status == slow.status == "success"
+    _same(fast, slow)
+    assert taken > fast.stats["steps"] // 2
+    assert fast.t.tolist() == t_eval
+
+
+@pytest.mark.parametrize("where", ["force", "drive"])
+def test_failure_inside_the_steps_is_python_s(where, monkeypatch):
+    # a load that becomes infinite (Newton's first residual is not finite) or a drive that returns NaN (its
+    # checked call raises) after 0.0123 s: the compiled steps stop before that step, Python's fails as alone
+    system = _loaded(force=lambda t: np.inf if t > 0.0123 else 1.0) if where == "force" else _loaded(
+        angle=lambda t: tuple(np.array([x]) for x in (np.nan if t > 0.0123 else t * t, 2 * t, 2.0)))
+    fast, slow, taken = _both(system, monkeypatch, 0.03, h=5e-4, rho_inf=0.8, t_eval=np.linspace(0.0, 0.03, 7),
+                              newton={"tol": 1e-10})
+    assert fast.status == slow.status == "failed"
+    assert fast.message == slow.message and ("not finite" if where == "force" else "finite arrays") in fast.message
+    assert fast.t_fail == slow.t_fail == pytest.approx(0.012)
+    assert taken > 10
+    _same(fast, slow)
+
+
+def test_weight_table_is_the_time_functions():
+    b = spinup("BE2D", 4, w_s=4.0)
+    rows = b.system.compiled_rows
+    times = np.array([0.0, 0.3, 7.5, 14.9, 15.0, 22.0])
+    table = rows.weight_table(times)
+    expect = np.array([rows.weights(t)[0] for t in times])
+    np.testing.assert_allclose(table, expect, rtol=0, atol=1e-15)
+    assert np.ptp(table[:, 1:], axis=0).max() > 0.5   # the drive's terms do vary over these times
+
+
+def test_bad_drive_named_from_the_table():
+    beam = Beam(BE2D(Material(2.0e9, 0.3, 1200.0), RectangularSection(0.02)), 2, 0.5)
+    bad = Prescribed((beam, 0), angle=lambda t: (np.array([np.nan if t > 0.1 else 0.0]), np.zeros(1), np.zeros(1)))
+    rows = System([beam], [bad]).compiled_rows
+    with pytest.raises(ValueError, match=r"`angle`\(t\) must return three finite arrays.*t = 0.2"):
+        rows.weight_table(np.array([0.0, 0.2]))
