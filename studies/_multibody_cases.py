@@ -14,7 +14,7 @@ import numpy as np
 
 from ancfdae.simulate import METHODS
 
-from ._multibody_models import BUILDERS
+from . import _multibody_models as models    # a module object: its source enters the stored cases' key
 
 __all__ = ["MODELS", "OPTIONS", "MULTIPLIER_OUTPUTS", "INVARIANTS", "fixed_step", "benchmark", "run_case",
            "outputs"]
@@ -37,7 +37,7 @@ def benchmark(name: str, t_end: float):
     """The benchmark ``name`` (:data:`MODELS`) built for the span ``[0, t_end]``."""
     element, n, opts = MODELS[name]
     opts = dict(opts, t_end=t_end) if name == "B7" else opts
-    return BUILDERS[name](element, n, **opts)
+    return models.BUILDERS[name](element, n, **opts)
 
 
 def run_case(case: dict) -> dict:
