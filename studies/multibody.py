@@ -198,11 +198,14 @@ def run(benchmarks=None, integrators=None, steps=None, rtols=None, t_end=None, r
     records = sweep.finished()
     rows, orders, orders_lam, refs, floors, local = summarize(records, methods)
     table = _table(rows, orders, orders_lam, local, refs, floors, sweep.errors) + _linear_b5(refs)
+    figures = {}
     if plots:
+        from ._multibody_plots import plot_multibody
+        figures = plot_multibody(records, rows, refs, methods, path)
         (path / "multibody.md").write_text("# Flexible multibody benchmarks B5-B7\n\n" + table)
     return {"rows": rows, "orders": orders, "orders_lam": orders_lam, "references": refs,
             "reference_errors": floors, "records": records, "errors": sweep.errors,
-            "reused": sweep.reused, "figures": {}, "table": table, "path": path}
+            "reused": sweep.reused, "figures": figures, "table": table, "path": path}
 
 
 def _linear_b5(refs) -> str:

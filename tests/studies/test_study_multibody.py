@@ -106,6 +106,10 @@ def test_quick_study_rows_and_orders(tmp_path):
     # the coarsest step's Newton stops at its tolerance on the crank's start (full run: 3.7e-7 at h = 8e-4)
     assert all(row["drift_q"] < 1e-6 for row in rows) and rows[-1]["drift_q"] < 1e-8
     assert (tmp_path / "multibody.md").is_file()
+    # Catches: a figure not written (or not both formats); B7's energy figure only with B7 in the run
+    for stem in ("work_precision", "drift", "multipliers"):
+        assert (tmp_path / f"{stem}.png").stat().st_size > 0 and (tmp_path / f"{stem}.svg").is_file()
+    assert set(r["figures"]) == {"work_precision", "drift", "multipliers"}
 
 
 def test_quick_study_runs_the_variable_step_method_at_its_tolerances(tmp_path):
