@@ -135,3 +135,16 @@ def test_b5_tip_deflection_converges_in_the_mesh_towards_the_exudyn_reference():
         errs.append(abs(b.outputs["tip_deflection"](res.t, res.q, res.v, res.lam)[-1] - ref["b5-4/deflection"][k]))
     assert errs[0] > errs[1] > errs[2]
     assert errs[2] < 1e-4 * abs(ref["b5-4/deflection"][k])   # measured 1.8e-5 m of 0.3155 m (2: 4.0e-3, 4: 9.1e-5)
+
+
+def test_full_study_outputs_lie_on_every_step_grid():
+    # Catches: output times inside steps (n_out = 201 put B7's at 0.025 s, between the steps of 0.02 and
+    # 0.01 s): there the stepper's interpolant is measured, not the method (energy-momentum's "energy error"
+    # 6.9e-2 at h = 0.02 instead of 1e-14).
+    full = multibody.FULL
+    for bm in full["benchmarks"]:
+        n_out = full["n_out"][bm] if isinstance(full["n_out"], dict) else full["n_out"]
+        dt = full["t_end"][bm] / (n_out - 1)
+        h_ref = min(full["steps"][bm]) / multibody.REFERENCE[bm][1]
+        for h in list(full["steps"][bm]) + [h_ref, 2 * h_ref]:
+            assert abs(dt / h - round(dt / h)) < 1e-9, (bm, h, dt)
