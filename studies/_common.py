@@ -185,7 +185,9 @@ def run_cases(fn, cases, out=None, executor: Executor | None = None, jobs: int |
     cost : callable, optional
         Relative cost of a case (``cost(case) -> float``); the progress bar
         advances by it, so that its estimate of the time left holds when the
-        cases differ in cost (default: equal).
+        cases differ in cost (default: equal), and an executor gets the cases
+        longest first (the workers then end together; the records keep the
+        order of ``cases``).
 
     Returns
     -------
@@ -252,7 +254,9 @@ def run_cases(fn, cases, out=None, executor: Executor | None = None, jobs: int |
                 # inside a test session) can deadlock the children; fresh interpreters cost ~1 s each.
                 pool = executor = ProcessPoolExecutor(max_workers=jobs, initializer=_ignore_sigint,
                                                       mp_context=multiprocessing.get_context("spawn"))
-            pending = {executor.submit(fn, cases[i]): i for i in todo}
+            # longest first (by ``cost``): the last case to start is a short one, so the workers end together
+            order = sorted(todo, key=lambda i: -weight[i]) if cost is not None else todo
+            pending = {executor.submit(fn, cases[i]): i for i in order}
             try:
                 while pending:
                     done, _ = wait(pending, return_when=FIRST_COMPLETED)

@@ -13,46 +13,59 @@ the multiplier outputs (hub torque, slider normal force, crank torque, pivot for
 to the reference's largest value, the largest over the kind), the position drift ``max |g|`` and the
 velocity drift ``max |G v + g_t|`` over the outputs, on B7 the energy error ``max |E - E0|`` relative to
 the largest kinetic energy and the drift of the angular momentum about the vertical, the CPU time; per
-integrator the observed orders of ``q`` and ``lambda`` (least-squares slopes of log error against log step).
+integrator the observed orders of ``q`` and ``lambda`` from its asymptotic runs only
+(:func:`ancfdae.studies._orders.asymptotic_order`). The cases run longest first (:data:`METHOD_COST`), so
+that the workers of a parallel run finish together; the case itself is defined in
+:mod:`ancfdae.studies._multibody_cases`.
 
 Run: ``ancfdae study multibody [--quick] [--out DIR] [--jobs N]``.
 """
 from __future__ import annotations
 
-import os
 import sys
-import time
 
 import numpy as np
 
-from ancfdae.simulate import METHODS
-
 from ._cli import Option, main as cli_main
 from ._common import Case, OptionError, output_dir, run_cases, settings
-from ._multibody_models import BUILDERS
+from ._multibody_cases import (INVARIANTS, MODELS, MULTIPLIER_OUTPUTS, benchmark, fixed_step, outputs,
+                               run_case)
+from ._orders import ORDER_TOL, asymptotic_order
 from ._tables import cell, errors_note, markdown_table
 
 __all__ = ["run", "run_case", "summarize", "FULL", "QUICK", "CLI_OPTIONS", "constrained_methods"]
 
-#: benchmark -> (element, elements, builder options)
-MODELS = {"B5": ("BE2D", 8, {"w_s": 4.0}), "B6": ("BE2D", 8, {}), "B7": ("Cable3D", 4, {"E": 5.0e7})}
-#: the outputs that are multipliers (reactions); the others but the invariants are positions
-MULTIPLIER_OUTPUTS = ("hub_torque", "slider_normal_force", "crank_torque", "pivot_force_z")
-INVARIANTS = ("energy", "angular_momentum_z")
 #: the reference method per benchmark and how much finer than the finest step it runs (its check: at twice
-#: its step). Lobatto IIIA-3 where it runs the whole span; on the 30-s B5 every method without numerical
-#: dissipation fails (Lobatto IIIA-3 at h = 0.0125 at 9.7 s, Lobatto IIIA-2 and Newmark at 9.6-12.6 s:
-#: Newton diverges), so B5's reference is generalized-alpha 8 times finer than the finest step.
-REFERENCE = {"B5": ("generalized-alpha", 8), "B6": ("lobatto3", 2), "B7": ("lobatto3", 2)}
+#: its step). Lobatto IIIA-3 where it runs the whole span: B7 4 times finer, so that its error bound (the
+#: difference from the check) lies 10x below the fourth-order methods' finest errors; B6 only 2 times finer
+#: (bound 8.4e-7, the finest errors of Lobatto IIIA-3 and energy-collocation: those runs then enter no order)
+#: because at h = 5e-5 Lobatto IIIA-3 stops at t = 0.11 s (Newton "diverging, rate 1 with a fresh Jacobian":
+#: stagnation at round-off). On the 30-s B5 every method without numerical dissipation fails
+#: (docs/studies.md, "B5: why the non-dissipative methods fail"), so B5's reference is generalized-alpha 8x finer.
+REFERENCE = {"B5": ("generalized-alpha", 8), "B6": ("lobatto3", 2), "B7": ("lobatto3", 4)}
 #: a run whose error is below FLOOR times the reference's error bound does not enter an order
 FLOOR = 10.0
-#: options per method (beyond h)
-OPTIONS = {"hht": {"alpha": 0.05}, "generalized-alpha": {"rho_inf": 0.8}}
+#: CPU per step relative to generalized-alpha, measured in the full run at e1b9706 (B6 and B7, finest
+#: steps); IDA: one run per tolerance as 40 of generalized-alpha's finest runs. Only orders the cases
+#: (longest first, so that two workers end together) and weighs the progress bar.
+METHOD_COST = {"lobatto3": 2.0, "lobatto2": 1.5, "energy-momentum": 6.0, "energy-collocation": 25.0,
+               "ida": 40.0}
 
+#: IDA's tolerances per benchmark, chosen by measurement (docs/studies.md): one each, at an error comparable to
+#: the fixed-step runs'. B5 none: at rtol 1e-3 IDA's error over the 30 s is 0.18 (generalized-alpha at
+#: h = 0.025: 5e-3) for 226 s CPU, at 1e-4 0.039 for 895 s (to 10 s: 2125 steps of ~2 ms, 14 % error;
+#: generalized-alpha 400 steps, 0.5 %). B6 1e-3: 6.3e-3 (the second-order methods at h = 2e-4: 6.5e-3 ...
+#: 7.5e-3) for 145 s. B7 1e-3: 8.0e-5 for 52 s, 62046 steps (at 1e-2: 0.29 in 339 steps; IDA resolves the
+#: rod's axial vibration once the tolerance is below its amplitude).
+RTOLS = {"B5": (), "B6": (1e-3,), "B7": (1e-3,)}
 FULL = dict(benchmarks=tuple(MODELS), integrators=None, steps={"B5": (0.1, 0.05, 0.025), "B6": (8e-4, 4e-4, 2e-4),
-            "B7": (0.02, 0.01, 0.005)}, rtols=(1e-3, 1e-4), t_end={"B5": 30.0, "B6": 0.5, "B7": 5.0},
-            refine=None, n_out=51)
-QUICK = dict(steps={"B5": (0.1, 0.05), "B6": (4e-4, 2e-4), "B7": (0.02, 0.01)}, rtols=(1e-3, 1e-4),
+            "B7": (0.02, 0.01, 0.005)}, rtols=RTOLS, t_end={"B5": 30.0, "B6": 0.5, "B7": 5.0},
+            refine=None, n_out={"B5": 301, "B6": 126, "B7": 251})
+#: FULL's n_out puts every output time on the step grid of every step (B5 0.1 s, B6 4e-3 s, B7 0.02 s): a time
+#: inside a step is the stepper's interpolant, whose error (and energy) is not the method's (with n_out = 201
+#: B7 energy-momentum showed an "energy error" 6.9e-2 at h = 0.02, 1.8e-14 at 0.005, on the grid)
+QUICK = dict(steps={"B5": (0.1, 0.05), "B6": (4e-4, 2e-4), "B7": (0.02, 0.01)},
+             rtols={"B5": (1e-3, 1e-4), "B6": (1e-3, 1e-4), "B7": (1e-3, 1e-4)},
              t_end={"B5": 4.0, "B6": 0.06, "B7": 0.2}, refine=None, n_out=11)
 CLI_OPTIONS = [
     Option("benchmarks", str, "benchmarks", nargs="+", choices=tuple(MODELS)),
@@ -62,57 +75,25 @@ CLI_OPTIONS = [
 
 def constrained_methods() -> list[str]:
     """The registered methods that run constrained models (``handles_constraints``)."""
+    from ancfdae.simulate import METHODS
     return [m for m, cls in METHODS.items() if getattr(cls, "handles_constraints", False)]
-
-
-def _fixed_step(method: str) -> bool:
-    """Whether ``method`` takes a step ``h`` (else it is variable-step and runs at the tolerances ``rtols``)."""
-    return bool(getattr(METHODS[method], "fixed_step", True))
 
 
 def _runs_at(method: str, h: float, methods, steps) -> bool:
     """Whether the sweep runs ``method`` at the step ``h``."""
-    return method in methods and _fixed_step(method) and any(np.isclose(h, x, rtol=1e-9) for x in steps)
+    return method in methods and fixed_step(method) and any(np.isclose(h, x, rtol=1e-9) for x in steps)
 
 
-def _benchmark(name: str, t_end: float):
-    element, n, opts = MODELS[name]
-    opts = dict(opts, t_end=t_end) if name == "B7" else opts
-    return BUILDERS[name](element, n, **opts)
+def _rtols_of(rtols, bm) -> tuple:
+    """IDA's tolerances on ``bm``: ``rtols`` per benchmark (a dict) or the same for all (a sequence)."""
+    if isinstance(rtols, dict):
+        return tuple(rtols.get(bm, ()))
+    return tuple(rtols)
 
 
-def run_case(case: dict) -> dict:
-    """One run: ``case = {benchmark, integrator, h, t_end, n_out}``; ``h`` is ``rtol`` for a variable-step method."""
-    os.environ.setdefault("OMP_NUM_THREADS", "1")
-    from ancfdae import simulate
-    b = _benchmark(case["benchmark"], case["t_end"])
-    t_eval = np.linspace(0.0, case["t_end"], case["n_out"])
-    t0 = time.process_time()
-    step = {"h": case["h"]} if _fixed_step(case["integrator"]) else {"rtol": case["h"]}
-    res = simulate(b.system, (0.0, case["t_end"]), case["integrator"], t_eval=t_eval, **step,
-                   **OPTIONS.get(case["integrator"], {}))
-    return {"result": res, "cpu": time.process_time() - t0, **case}
-
-
-def outputs(record: dict) -> dict:
-    """The benchmark's outputs, the constraint drift and (B7) the invariants of a stored run."""
-    res = record["result"]
-    b = _benchmark(record["benchmark"], record["t_end"])
-    s = b.system
-    out = {k: np.asarray(f(res.t, res.q, res.v, res.lam)) for k, f in b.outputs.items()}
-    g = np.array([s.constraints(t, q) for t, q in zip(res.t, res.q)])
-    gv = np.array([s.constraint_jacobian(t, q) @ v + s.constraint_rates(t, q, v)[0]
-                   for t, q, v in zip(res.t, res.q, res.v)])
-    rec = {k: v for k, v in record.items() if k != "result"}
-    rec.update(t=res.t, out=out, status=res.status, message=res.message,
-               drift_q=float(np.abs(g).max()) if g.size else float("nan"),
-               drift_v=float(np.abs(gv).max()) if gv.size else float("nan"))
-    if "energy" in out and res.t.size:
-        T = np.array([s.energy(t, q, v).kinetic for t, q, v in zip(res.t, res.q, res.v)])
-        rec["energy_error"] = float(np.abs(out["energy"] - out["energy"][0]).max() / T.max())
-        L = out["angular_momentum_z"]
-        rec["momentum_error"] = float(np.abs(L - L[0]).max() / abs(L[0]))
-    return rec
+def _per_benchmark(value, bm):
+    """``value[bm]`` for a per-benchmark option (a dict), else ``value``."""
+    return value[bm] if isinstance(value, dict) else value
 
 
 def _errors(rec, ref) -> dict:
@@ -127,15 +108,6 @@ def _errors(rec, ref) -> dict:
         out[kind] = float(max(np.abs(rec["out"][k] - ref["out"][k]).max() / max(np.abs(ref["out"][k]).max(), 1e-300)
                               for k in keys))
     return out
-
-
-def _order(points, floor) -> float | None:
-    """Least-squares slope of log error against log step over the points above ``FLOOR * floor``."""
-    pts = [(h, e) for h, e in points if np.isfinite(e) and e > FLOOR * floor]
-    if len(pts) < 2:
-        return None
-    h, e = np.log(np.array(pts)).T
-    return float(np.polyfit(h, e, 1)[0])
 
 
 def summarize(records: list[dict], methods) -> tuple:
@@ -155,15 +127,17 @@ def summarize(records: list[dict], methods) -> tuple:
         e = _errors(r, refs[r["benchmark"]])
         rows.append({k: r.get(k) for k in ("benchmark", "integrator", "h", "status", "cpu", "drift_q", "drift_v",
                                             "energy_error", "momentum_error")} | {"error": e["q"], "error_lam": e["lam"]})
-    orders, orders_lam = {}, {}
+    orders, orders_lam, local = {}, {}, {}
     for bm in refs:
         for m in methods:
             mine = [r for r in rows if r["benchmark"] == bm and r["integrator"] == m]
             for key, kind, dest in (("error", "q", orders), ("error_lam", "lam", orders_lam)):
-                p = _order([(r["h"], r[key]) for r in mine], np.nan_to_num(floors[bm][kind], nan=0.0))
+                p, loc = asymptotic_order([(r["h"], r[key]) for r in mine],
+                                          float(np.nan_to_num(floors[bm][kind], nan=0.0)), FLOOR)
+                local[(bm, m, kind)] = loc
                 if p is not None:
                     dest[(bm, m)] = p
-    return rows, orders, orders_lam, refs, floors
+    return rows, orders, orders_lam, refs, floors, local
 
 
 def run(benchmarks=None, integrators=None, steps=None, rtols=None, t_end=None, refine=None, n_out=None,
@@ -179,15 +153,15 @@ def run(benchmarks=None, integrators=None, steps=None, rtols=None, t_end=None, r
         Default: :func:`constrained_methods`.
     steps, t_end : dict
         Steps and end time per benchmark.
-    rtols : sequence of float
-        The relative tolerances of the variable-step methods (IDA), in place of the steps (IDA costs
-        about 10 times generalized-alpha's CPU per decade of rtol on B6: 6 s at 1e-4, 72 s at 1e-5 for the
-        quick 0.05 s; hence 1e-3 and 1e-4).
+    rtols : dict or sequence of float
+        The relative tolerances of the variable-step methods (IDA), in place of the steps: per benchmark
+        (default :data:`RTOLS`, chosen by measurement) or one sequence for every benchmark.
     refine : int, optional
         The reference runs its method (:data:`REFERENCE`) at the finest step divided by ``refine`` (its check
         at twice that); default: the benchmark's own in :data:`REFERENCE`.
-    n_out : int
-        Output times (equally spaced, both ends included).
+    n_out : int or dict
+        Output times (equally spaced, both ends included), per benchmark or for all; keep them on the step
+        grid of every step (see :data:`FULL`).
     quick, out, jobs, executor, plots, progress
         The sweep options of every study (:mod:`ancfdae.studies._common`).
 
@@ -205,31 +179,43 @@ def run(benchmarks=None, integrators=None, steps=None, rtols=None, t_end=None, r
     if unknown or not methods:
         raise OptionError(f"`integrators` must name methods that handle constraints {constrained_methods()}, "
                           f"got {methods}.")
+    bad = [x for bm in o["benchmarks"] for x in _rtols_of(o["rtols"], bm)
+           if isinstance(x, bool) or not isinstance(x, (int, float)) or not (np.isfinite(x) and x > 0)]
+    if bad:
+        raise OptionError(f"`rtols` must be positive finite tolerances (per benchmark or for all), got {o['rtols']!r}.")
     path = output_dir("multibody", out, quick) if (plots or out is not None) else None
-    cases = []
+    cases, finest = [], {bm: min(o["steps"][bm]) for bm in o["benchmarks"]}
     for bm in o["benchmarks"]:
-        base = {"benchmark": bm, "t_end": o["t_end"][bm], "n_out": o["n_out"]}
+        base = {"benchmark": bm, "t_end": o["t_end"][bm], "n_out": _per_benchmark(o["n_out"], bm)}
         method, refine_bm = REFERENCE[bm]
-        h_ref = min(o["steps"][bm]) / (o["refine"] or refine_bm)
+        h_ref = finest[bm] / (o["refine"] or refine_bm)
         # the check is the reference method's own run at 2 h_ref when the sweep has it (refine = 2)
         roles = [(1, "main")] + ([] if _runs_at(method, 2 * h_ref, methods, o["steps"][bm]) else [(2, "check")])
         cases += [Case(dict(base, integrator=method, h=k * h_ref, reference=role),
-                       label=f"{bm} reference ({role}) h={k * h_ref:g}", cost=4 * base["t_end"] / (k * h_ref))
-                  for k, role in roles]
+                       label=f"{bm} reference ({role}) h={k * h_ref:g}") for k, role in roles]
         for m in methods:
-            xs, name = (o["steps"][bm], "h") if _fixed_step(m) else (o["rtols"], "rtol")
-            cases += [Case(dict(base, integrator=m, h=x, reference=False), label=f"{bm} {m} {name}={x:g}",
-                           cost=base["t_end"] / (x if name == "h" else h_ref)) for x in xs]
+            xs, name = (o["steps"][bm], "h") if fixed_step(m) else (_rtols_of(o["rtols"], bm), "rtol")
+            cases += [Case(dict(base, integrator=m, h=x, reference=False), label=f"{bm} {m} {name}={x:g}")
+                      for x in xs]
+
+    def cost(c):
+        """Relative CPU of a case: its steps times :data:`METHOD_COST` (IDA: as at the finest step)."""
+        h = c["h"] if fixed_step(c["integrator"]) else finest[c["benchmark"]]
+        return METHOD_COST.get(c["integrator"], 1.0) * c["t_end"] / h
+
     sweep = run_cases(run_case, cases, out=path, executor=executor, jobs=jobs, reduce=outputs, name="multibody",
-                      progress=progress, cost=lambda c: c["cost"])
+                      progress=progress, cost=cost)
     records = sweep.finished()
-    rows, orders, orders_lam, refs, floors = summarize(records, methods)
-    table = _table(rows, orders, orders_lam, refs, floors, sweep.errors) + _linear_b5(refs)
+    rows, orders, orders_lam, refs, floors, local = summarize(records, methods)
+    table = _table(rows, orders, orders_lam, local, refs, floors, sweep.errors) + _linear_b5(refs)
+    figures = {}
     if plots:
+        from ._multibody_plots import plot_multibody
+        figures = plot_multibody(records, rows, refs, methods, path)
         (path / "multibody.md").write_text("# Flexible multibody benchmarks B5-B7\n\n" + table)
     return {"rows": rows, "orders": orders, "orders_lam": orders_lam, "references": refs,
             "reference_errors": floors, "records": records, "errors": sweep.errors,
-            "reused": sweep.reused, "figures": {}, "table": table, "path": path}
+            "reused": sweep.reused, "figures": figures, "table": table, "path": path}
 
 
 def _linear_b5(refs) -> str:
@@ -245,21 +231,32 @@ def _linear_b5(refs) -> str:
             f"{ref['t'][int(np.argmax(w_lin))]:g} s), the ANCF reference's {w.max():.3g} m.\n")
 
 
-def _table(rows, orders, orders_lam, refs, floors, errors) -> str:
+def _order_cell(orders, local, bm, m, kind) -> str:
+    """The order where the runs are asymptotic, else the local orders in parentheses ("-": fewer than 2 runs)."""
+    p = orders.get((bm, m))
+    if p is not None:
+        return f"{p:.2f}"
+    loc = local.get((bm, m, kind)) or []
+    return "(" + ", ".join(f"{x:.2f}" for x in loc) + ")" if loc else "-"
+
+
+def _table(rows, orders, orders_lam, local, refs, floors, errors) -> str:
     headers = ["benchmark", "integrator", "h (s) or rtol", "status", "error q", "order q", "error lambda",
                "order lambda", "max |g|", "max |G v + g_t|", "energy error (B7)", "L_z drift (B7)", "CPU (s)"]
     body = [[r["benchmark"], r["integrator"], f"{r['h']:g}", r["status"], cell(r["error"], ".2e"),
-             cell(orders.get((r["benchmark"], r["integrator"])), ".2f"), cell(r["error_lam"], ".2e"),
-             cell(orders_lam.get((r["benchmark"], r["integrator"])), ".2f"), cell(r["drift_q"], ".1e"),
+             _order_cell(orders, local, r["benchmark"], r["integrator"], "q"), cell(r["error_lam"], ".2e"),
+             _order_cell(orders_lam, local, r["benchmark"], r["integrator"], "lam"), cell(r["drift_q"], ".1e"),
              cell(r["drift_v"], ".1e"), cell(r["energy_error"], ".1e"), cell(r["momentum_error"], ".1e"),
              f"{r['cpu']:.1f}"] for r in rows]
     text = "References: " + ", ".join(
         f"{bm} {r['integrator']} at h = {r['h']:g} s (differs from the run at 2h by {cell(floors[bm]['q'], '.1e')} in q, "
         f"{cell(floors[bm]['lam'], '.1e')} in lambda)" for bm, r in refs.items()) + \
         ". Errors: largest over the position (q) or multiplier (lambda: hub torque, slider normal force, crank " \
-        "torque, pivot force) outputs, each relative to the reference's largest value; order: slope of log " \
-        f"error against log h (IDA: against log rtol) over the runs whose error exceeds {FLOOR:g} times the " \
-        "reference's difference from its check.\n\n"
+        "torque, pivot force) outputs, each relative to the reference's largest value. Order: only from " \
+        f"asymptotic runs (studies/_orders.py): runs whose error exceeds {FLOOR:g} times the reference's " \
+        "difference from its check, the finest chain of at least two successive local orders (log error " \
+        f"ratio over log h ratio; IDA: over log rtol ratio) that agree within {ORDER_TOL:.0%}, fitted; " \
+        "otherwise the local orders are given in parentheses.\n\n"
     return text + markdown_table(headers, body) + errors_note(errors)
 
 

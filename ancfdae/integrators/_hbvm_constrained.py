@@ -26,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from ancfdae.constrained import multipliers
 from ancfdae.integrators.protocol import Quadrature, StepOutcome
 
 __all__ = ["constrained_hbvm_equations", "constrained_hbvm_step"]
@@ -112,9 +113,12 @@ def constrained_hbvm_step(st, t0: float, h: float) -> StepOutcome:
     q1 = st.q + (h * st.v + Y @ co.q_end)
     v1 = st.v + Y[:, 0] / h
     lam1 = Lam[0] + _P1(1.0) * Lam[1]                                  # the multiplier polynomial at t1
-    rhs = -np.asarray(model.residual(t1, q1, v1, np.zeros_like(q1)), dtype=float) \
-        - model.constraint_jacobian(t1, q1).T @ lam1
-    a1 = st._Mlu.solve(rhs)
+    # The acceleration at t1 (the next step's first guess, the interpolation) from the saddle-point (KKT)
+    # system at (t1, q1, v1): M alone may be singular (a lamina payload's axis director carries no mass).
+    try:
+        a1, _ = multipliers(model, t1, q1, v1, assembler=st._kkt_out)
+    except np.linalg.LinAlgError as exc:
+        return StepOutcome.failure(str(exc))
     if not np.all(np.isfinite(a1)):
         return StepOutcome.failure(f"the acceleration at t = {t1:.9g} is not finite (the model's residual there)")
     st._prev = (h, Y)

@@ -62,6 +62,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ancfdae import _validate as validate
+from ancfdae.kkt import KKTAssembler
 from ancfdae._scale import ENERGY_ROUNDOFF
 from ancfdae.integrators._alpha_index3 import mass_scale
 from ancfdae.integrators._energy_correction import VelocityCorrection, energy_defect, keep_residual, round_off_test
@@ -182,7 +183,12 @@ class EnergyCollocation(NewtonStepper):
     def _bind(self):
         m = self.model
         self._M = sp.csr_matrix(m.mass(self.q))
-        self._Mlu = spla.splu(sp.csc_matrix(self._M))
+        # M alone is factorised for the unconstrained step's acceleration only: a constrained model's M may be
+        # singular (a lamina's axis director carries no mass), its accelerations come from the saddle-point
+        # (KKT) system, regular on the constraint manifold.
+        constrained = "constraints" in capabilities(m)
+        self._Mlu = None if constrained else spla.splu(sp.csc_matrix(self._M))
+        self._kkt_out = KKTAssembler() if constrained else None
         z = np.zeros(self.n_dof)
         self._Mcsr = sp.csr_matrix(m.jacobian(self.t, self.q, z, z).M)   # the mass on the stiffness' pattern
         self._prev = None          # (h, Y) of the last step: the predictor

@@ -95,21 +95,28 @@ def test_b7_energy_momentum_keeps_energy_and_constraints():
 
 def test_quick_study_rows_and_orders(tmp_path):
     # Catches: a study whose errors do not fall with the step (wrong reference or outputs misaligned).
-    r = multibody.run(benchmarks=["B6"], integrators=["generalized-alpha"], quick=True, out=tmp_path, progress=False)
+    # three steps: an order needs two agreeing local orders (studies/_orders.py)
+    r = multibody.run(benchmarks=["B6"], integrators=["generalized-alpha"], quick=True, out=tmp_path, progress=False,
+                      steps={"B6": (8e-4, 4e-4, 2e-4)})
     assert not r["errors"], r["errors"]
     rows = r["rows"]
     assert [row["h"] for row in rows] == sorted((row["h"] for row in rows), reverse=True)
     assert rows[-1]["error"] < rows[0]["error"]
-    assert r["orders"][("B6", "generalized-alpha")] > 1.0
-    assert all(row["drift_q"] < 1e-8 for row in rows)
+    assert 1.5 < r["orders"][("B6", "generalized-alpha")] < 2.5
+    # the coarsest step's Newton stops at its tolerance on the crank's start (full run: 3.7e-7 at h = 8e-4)
+    assert all(row["drift_q"] < 1e-6 for row in rows) and rows[-1]["drift_q"] < 1e-8
     assert (tmp_path / "multibody.md").is_file()
+    # Catches: a figure not written (or not both formats); B7's energy figure only with B7 in the run
+    for stem in ("work_precision", "drift", "multipliers"):
+        assert (tmp_path / f"{stem}.png").stat().st_size > 0 and (tmp_path / f"{stem}.svg").is_file()
+    assert set(r["figures"]) == {"work_precision", "drift", "multipliers"}
 
 
 def test_quick_study_runs_the_variable_step_method_at_its_tolerances(tmp_path):
     # Catches: a step h handed to IDA (simulate refuses it: every IDA case failed), rtols not applied.
     r = multibody.run(benchmarks=["B5"], integrators=["ida"], quick=True, out=tmp_path, progress=False)
     assert not r["errors"], r["errors"]
-    assert [row["h"] for row in r["rows"]] == list(multibody.QUICK["rtols"])
+    assert [row["h"] for row in r["rows"]] == list(multibody.QUICK["rtols"]["B5"])
     assert all(row["status"] == "success" for row in r["rows"])
     assert r["rows"][-1]["error"] < r["rows"][0]["error"]
 
@@ -128,3 +135,16 @@ def test_b5_tip_deflection_converges_in_the_mesh_towards_the_exudyn_reference():
         errs.append(abs(b.outputs["tip_deflection"](res.t, res.q, res.v, res.lam)[-1] - ref["b5-4/deflection"][k]))
     assert errs[0] > errs[1] > errs[2]
     assert errs[2] < 1e-4 * abs(ref["b5-4/deflection"][k])   # measured 1.8e-5 m of 0.3155 m (2: 4.0e-3, 4: 9.1e-5)
+
+
+def test_full_study_outputs_lie_on_every_step_grid():
+    # Catches: output times inside steps (n_out = 201 put B7's at 0.025 s, between the steps of 0.02 and
+    # 0.01 s): there the stepper's interpolant is measured, not the method (energy-momentum's "energy error"
+    # 6.9e-2 at h = 0.02 instead of 1e-14).
+    full = multibody.FULL
+    for bm in full["benchmarks"]:
+        n_out = full["n_out"][bm] if isinstance(full["n_out"], dict) else full["n_out"]
+        dt = full["t_end"][bm] / (n_out - 1)
+        h_ref = min(full["steps"][bm]) / multibody.REFERENCE[bm][1]
+        for h in list(full["steps"][bm]) + [h_ref, 2 * h_ref]:
+            assert abs(dt / h - round(dt / h)) < 1e-9, (bm, h, dt)

@@ -56,6 +56,31 @@ def test_a_case_that_raises_in_a_worker_is_recorded(tmp_path):
     assert "RuntimeError: case 0 is broken" in error and "study_toy.py" in error     # the worker's traceback
 
 
+class _RecordingExecutor:
+    """Runs each submitted case at once, in the caller, and remembers the order of submission."""
+
+    def __init__(self):
+        from concurrent.futures import Future
+        self.order, self._future = [], Future
+
+    def submit(self, fn, case):
+        self.order.append(case["i"])
+        fut = self._future()
+        fut.set_result(fn(case))
+        return fut
+
+
+def test_an_executor_gets_the_longest_cases_first_and_the_records_keep_their_order():
+    # Catches: cases submitted in the given order (a long case started last keeps one worker busy while
+    # the other idles: the multibody study's B5 IDA case), records returned in the submission order.
+    ex = _RecordingExecutor()
+    cases = [Case(i=i, label=f"case {i}") for i in range(4)]
+    sweep = run_cases(lambda c: {"square": c["i"] ** 2}, cases, executor=ex, progress=False,
+                      cost=lambda c: [1.0, 5.0, 2.0, 9.0][c["i"]])
+    assert ex.order == [3, 1, 2, 0]
+    assert [r["square"] for r in sweep.records] == [0, 1, 4, 9]
+
+
 def test_output_folder_checked_before_any_work(tmp_path, monkeypatch, capsys):
     file = tmp_path / "results.txt"
     file.write_text("not a folder")
