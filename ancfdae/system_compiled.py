@@ -88,8 +88,13 @@ class SystemArrays:
         self._times = times
         self.n_weights = n_w + len(times)
         beam, off = beam_at
-        q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices = compiled.arrays
-        self.beam = (int(off), int(beam.n_dof), q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices)
+        q_fixed, gather, vec_slot, mat_slot = compiled.arrays[:4]
+        # the mass in the assembly's own pattern (stored zeros kept): the KKT fill adds the tangent's data
+        # and the mass's entry by entry, so both must share one pattern (compiled.arrays holds the mass
+        # without its zeros, for products only)
+        asm = beam._asm
+        self.beam = (int(off), int(beam.n_dof), q_fixed, gather, vec_slot, mat_slot, beam._M_data,
+                     asm.indptr, asm.indices)
         self.element_args = compiled.element_args
         self.compiled, self._beam_model = compiled, beam
         # the beam's external force: gravity alone is constant; dead loads need their time functions
