@@ -98,6 +98,7 @@ def test_loaded_system_matches_the_python_path(dead, method, opts, monkeypatch):
     assert fast.t.tolist() == t_eval
 
 
+@pytest.mark.filterwarnings("ignore:invalid value encountered:RuntimeWarning")   # the planted infinite load
 @pytest.mark.parametrize("where", ["force", "drive"])
 def test_failure_inside_the_steps_is_python_s(where, monkeypatch):
     # a load that becomes infinite (Newton's first residual is not finite) or a drive that returns NaN (its
