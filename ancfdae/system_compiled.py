@@ -21,7 +21,7 @@ import math
 
 import numpy as np
 
-from ancfdae.integrators._newton import max_abs
+from ancfdae._scale import max_abs
 
 __all__ = ["SystemArrays"]
 

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ancfdae.integrators._newton import max_abs
+from ancfdae._scale import max_abs
 from ancfdae.integrators.protocol import StepOutcome
 
 if TYPE_CHECKING:

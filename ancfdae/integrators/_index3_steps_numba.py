@@ -35,7 +35,7 @@ import numpy as np
 from numba import njit
 
 from ancfdae.integrators._linsolve_numba import band_solve
-from ancfdae.integrators._newton import max_abs
+from ancfdae._scale import max_abs
 from ancfdae.joints.assembled_numba import _g_force, _rates
 from ancfdae.models.beam.assembly_numba import finish_residual
 

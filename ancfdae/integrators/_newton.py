@@ -24,12 +24,12 @@ from typing import Callable
 
 import numpy as np
 from numpy.typing import ArrayLike
-from numba import njit
 
+from .._scale import max_abs
 from ._linsolve import factorize
 from ._newton_records import NewtonOptions, NewtonOutcome, NewtonStats
 
-__all__ = ["NewtonSolver", "max_abs"]
+__all__ = ["NewtonSolver"]
 
 #: A rate above this with a matrix evaluated during the current attempt counts
 #: as divergence; two such iterations in a row end the attempt early.
@@ -42,21 +42,6 @@ DIVERGENCE_RATE = 1.0
 ACCEPT_AFTER_CORRECTION = 100.0
 
 
-@njit(cache=True)
-def max_abs(x):
-    """``max|x|`` of a 1-D array, 0 when empty, NaN if any entry is NaN (inf propagates).
-
-    One compiled pass: ``float(np.abs(x).max())`` costs 1.4 us on a Newton-sized
-    vector, mostly call overhead, and runs three times per iteration.
-    """
-    m = 0.0
-    for v in x:
-        a = abs(v)
-        if a != a:
-            return a
-        if a > m:
-            m = a
-    return m
 
 
 class _Factor:

@@ -30,7 +30,7 @@ from numpy.typing import ArrayLike
 from ancfdae import _validate as validate
 from ancfdae.constrained import multipliers
 from ancfdae.integrators._ida_jacobian import _JacobianFiller
-from ancfdae.integrators._newton import max_abs
+from ancfdae._scale import max_abs
 from ancfdae.integrators.ida_constrained import GGLResidual
 from ancfdae.integrators.integrator import Integrator
 from ancfdae.integrators.protocol import StepOutcome

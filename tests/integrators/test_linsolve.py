@@ -4,7 +4,7 @@ import pytest
 import scipy.sparse as sp
 
 from ancfdae.integrators import _linsolve as ls
-from ancfdae.integrators._newton import max_abs
+from ancfdae._scale import max_abs
 
 
 def _banded(n, kl, ku, seed=0, dtype=float):

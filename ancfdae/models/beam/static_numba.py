@@ -35,7 +35,7 @@ import numpy as np
 from numba import njit
 
 from ...integrators._linsolve_numba import band_factor, band_fill, band_solve
-from ...integrators._newton import max_abs
+from ..._scale import max_abs
 
 __all__ = ["static_newton", "CONVERGED_INITIAL", "CONVERGED", "STAGNANT", "INITIAL_NOT_FINITE",
            "DX_NOT_FINITE", "R_NOT_FINITE", "DIVERGING", "MAX_ITER"]
