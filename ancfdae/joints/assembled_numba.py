@@ -22,7 +22,7 @@ import scipy.sparse as sp
 from numba import njit
 
 from ancfdae.joints.assembled import ConstraintSet
-from ancfdae.models.beam.assembly import fast_csr
+from ancfdae._csr import fast_csr
 
 __all__ = ["CompiledConstraintSet"]
 
