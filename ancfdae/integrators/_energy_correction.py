@@ -22,8 +22,12 @@ relative part. Without translations (a support) only the scaling applies, to the
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 
-__all__ = ["VelocityCorrection", "MAX_SCALING", "ENERGY_DEFECT", "energy_defect", "round_off_test", "keep_residual"]
+from ancfdae.integrators._csr_numba import csr_matvec
+
+__all__ = ["VelocityCorrection", "PotentialDefect", "MAX_SCALING", "ENERGY_DEFECT", "energy_defect", "round_off_test",
+           "keep_residual"]
 
 _EPS = float(np.finfo(float).eps)
 #: Newton's round-off test accepts a step when the energy defect is below this times eps times its terms' size.
@@ -50,7 +54,8 @@ class VelocityCorrection:
         generators = getattr(model, "symmetry_generators", None)
         if generators is not None:
             T = np.asarray(generators()[0], dtype=float).reshape(M.shape[0], -1)
-        self._M = M
+        M = sp.csr_matrix(M)
+        self._M = (M.indptr, M.indices, M.data)     # M v compiled: scipy's product costs 20-30 us to call
         self._T = T
         self._MT = np.asarray(M @ T) if T.shape[1] else T
         # (T^T M T)^-1, the translations' mass (d x d): every product below is with it or the dense M T
@@ -72,10 +77,10 @@ class VelocityCorrection:
 
         Notes
         -----
-        One sparse product ``M v1``; the rest are products with the ``d`` translations (``M T`` dense).
+        One sparse product ``M v1`` (compiled); the rest are products with the ``d`` translations (``M T`` dense).
         """
         T, MT, inv = self._T, self._MT, self._TMT_inv
-        Mv = self._M @ v1
+        Mv = csr_matvec(*self._M, v1)
         target = 0.5 * float(v1 @ Mv) - defect
         if T.shape[1]:
             dc = inv @ (-h * (T.T @ R0))            # the momentum's translation velocity
@@ -96,6 +101,40 @@ class VelocityCorrection:
             return None
         alpha = delta / (np.sqrt(1.0 + delta) + 1.0)
         return vt + (1.0 + alpha) * w
+
+
+class PotentialDefect:
+    """The step's energy defect from the model's own energy: ``D = T(v1) + P(q1) - T(v0) - P(q0) - W``.
+
+    ``sum_i V_i . R_i`` (:func:`energy_defect`) is the step's energy defect only where the ``k``-point rule
+    integrates ``grad P(sigma) . sigma'`` exactly (a polynomial ``P`` of degree ``<= k``); otherwise it misses
+    the rule's error, ``O(h^(2k+1))`` per step. This defect is the balance itself, exact for every potential,
+    at the price of one :meth:`~ancfdae.problem.PotentialModel.potential` call per step (``P(q0)`` is the
+    previous step's ``P(q1)`` while the state is that step's). ``W`` is the loads' work by the step's own rule
+    (the one handed to the monitors), so ``T + U + V - W_ext`` is what the correction keeps.
+
+    Parameters
+    ----------
+    model : PotentialModel
+    M : sparse matrix
+        The constant mass matrix.
+    """
+
+    def __init__(self, model, M) -> None:
+        M = sp.csr_matrix(M)
+        self._model, self._M = model, (M.indptr, M.indices, M.data)
+        self._last = (None, 0.0)          # (q1, P(q1)) of the last call: P(q0) of the next step
+
+    def __call__(self, t0: float, q0: np.ndarray, v0: np.ndarray, t1: float, q1: np.ndarray, v1: np.ndarray,
+                 work: float) -> float:
+        """``D`` of the step ``(t0, q0, v0) -> (t1, q1, v1)`` whose loads did the work ``work``."""
+        model, M = self._model, self._M
+        last_q, P0 = self._last
+        if last_q is not q0:
+            P0 = float(model.potential(t0, q0))
+        P1 = float(model.potential(t1, q1))
+        self._last = (q1, P1)
+        return (0.5 * float(v1 @ csr_matvec(*M, v1)) + P1) - (0.5 * float(v0 @ csr_matvec(*M, v0)) + P0) - work
 
 
 def energy_defect(Y: np.ndarray, R: np.ndarray, X: np.ndarray, hv: np.ndarray) -> float:

@@ -15,21 +15,20 @@ the energy-preserving variant of collocation: Hairer, JNAIAM 5:73, 2010; the not
 :mod:`ancfdae.integrators._hbvm_coefficients`). The unknowns are the two Legendre coefficients of the
 acceleration, ``2 n_dof`` numbers as for Lobatto IIIA-3; only the number of force evaluations per
 residual grows with ``k``. Only the conservative force ``grad P`` needs the ``k`` nodes: the loads
-``f_nc`` are projected with the 2-point Gauss rule (``k = 2``, the Gauss method's own rule, order 4),
-which on B2 halves the cost of a residual (BE2D's dead moment depends on the slopes and is evaluated
-per node in Python, several times the compiled internal forces).
+``f_nc`` are projected with the 2-point Gauss rule (``k = 2``, the Gauss method's own rule, order 4).
 
 What holds
 ----------
 * Order 4 in ``q`` and ``v`` (``2 s``), symmetric, for every ``k >= 2``.
-* Energy: ``T1 - T0 + P1 - P0 = h sum_j b_j f_nc(t_j, sigma_j) . sigma'_j`` (2 Gauss nodes ``j``) whenever the ``k``-point
-  rule integrates ``grad P(sigma(c)) . sigma'(c)`` exactly: for a polynomial ``P`` of degree
-  ``nu <= k`` (``2 k / s``). The default ``k`` is therefore the declared ``potential_degree`` (4 for
-  the St. Venant-Kirchhoff continuum formulations); for the other potentials (BE2D, Cable3D, the
-  structural SQ formulations) :data:`SMOOTH_SILENT_STAGES`, where the energy error per step,
-  ``O(h^(2k+1))``, lies below round-off at the steps that resolve the motion. The step hands the
-  loads' rule to the monitors (:class:`~ancfdae.integrators.Quadrature`: nodes ``t_j``, ``sigma_j``,
-  ``sigma'_j``, weights ``h b_j``), so ``T + U + V - W_ext`` is constant under loads.
+* Energy: ``T1 - T0 + P1 - P0 = h sum_j b_j f_nc(t_j, sigma_j) . sigma'_j`` (2 Gauss nodes ``j``) whenever the
+  ``k``-point rule integrates ``grad P(sigma(c)) . sigma'(c)`` exactly: for a polynomial ``P`` of degree
+  ``nu <= k`` (``2 k / s``), so the default ``k`` is the declared ``potential_degree`` (4 for the St.
+  Venant-Kirchhoff continuum formulations). For the other potentials (BE2D, Cable3D, the structural SQ
+  formulations) the rule misses ``O(h^(2k+1))`` per step: the velocity correction removes the balance
+  computed from the model's potential (``energy_defect="potential"``), and ``k`` =
+  :data:`CORRECTED_SILENT_STAGES` is chosen for the accuracy alone (:data:`SMOOTH_SILENT_STAGES` where the rule
+  must keep the energy itself: ``energy_correction="newton"``). The step hands the loads' rule to the
+  monitors (:class:`~ancfdae.integrators.Quadrature`), so ``T + U + V - W_ext`` is constant under loads.
 * Linear momentum ``T^T M v``: exact (the rule sums internal forces orthogonal to the translations).
   Angular momentum: not exact (the forces are evaluated off the configuration a rotation invariant
   needs); it drifts at the truncation error's size (``docs/energy_momentum.md``).
@@ -43,14 +42,14 @@ Modified Newton on the shared solver. For any iterate ``Y`` with residual ``R`` 
 by exactly ``sum_i V_i . R_i`` (``V = [h v0, 0] + Y X^T``, the Legendre coefficients of ``h sigma'``), so the
 energy needs no Newton at round-off: by default (``energy_correction="velocity"``, unconstrained models)
 Newton stops at Lobatto IIIA-3's relative tolerance 1e-8 and that known defect, with the momentum defect
-``h T^T R_0``, is removed from ``v1`` (:mod:`ancfdae.integrators._energy_correction`; B3 8 SQ3D: 5.5
-iterations per step against 7.1 to 9.0 at round-off). ``"newton"`` (constrained models) iterates on until
+``h T^T R_0``, is removed from ``v1`` (:mod:`ancfdae.integrators._energy_correction`). ``"newton"`` (constrained models) iterates on until
 the defect is at round-off (the defaults of :data:`~ancfdae.integrators.energy_momentum.DEFAULT_NEWTON`,
 the solver's ``accept``). The exact Jacobian of the
 stage equations is ``dR_i/dY_m = delta_im M / h^2 + sum_l C[i, m, l] H_l - sum_j C'[i, m, j] Kf_j`` with
 the Hessian ``H_l`` of ``P`` at every node and the load tangent ``Kf_j`` at the loads' nodes (real,
 ``2 n_dof`` square, interleaved, banded). The default iteration matrix freezes
-one stiffness ``K`` of the residual, at the step's midpoint: then ``sum_l C[:, :, l] = X^2`` and the matrix splits in the
+one stiffness ``K`` of the residual, at ``sigma(JACOBIAN_NODE h)`` (ahead of the midpoint: the matrix serves the
+next steps too): then ``sum_l C[:, :, l] = X^2`` and the matrix splits in the
 eigenbasis of ``X`` (eigenvalues ``1/4 +- i / sqrt(48)``, those of Lobatto IIIA-3's implicit block)
 into one complex ``n_dof`` square banded LU, as Lobatto IIIA-3 (:class:`~ancfdae.integrators._linsolve.StageMatrix`).
 A step that fails with it is retried with the exact Jacobian; full Newton uses the exact Jacobian.
@@ -65,10 +64,11 @@ from ancfdae import _validate as validate
 from ancfdae.kkt import KKTAssembler
 from ancfdae._scale import ENERGY_ROUNDOFF
 from ancfdae.integrators._alpha_index3 import mass_scale
-from ancfdae.integrators._energy_correction import VelocityCorrection, energy_defect, keep_residual, round_off_test
+from ancfdae.integrators._energy_correction import (PotentialDefect, VelocityCorrection, energy_defect, keep_residual,
+                                                    round_off_test)
 from ancfdae.integrators._hbvm_coefficients import hbvm_coefficients
 from ancfdae.integrators._hbvm_constrained import constrained_hbvm_step
-from ancfdae.integrators._hbvm_matrix import _SplitMatrix, interleaved_pattern
+from ancfdae.integrators._hbvm_matrix import ExactMatrix, _SplitMatrix
 from ancfdae.integrators._hbvm_numba import stage_residual
 from ancfdae.integrators._newton_records import NewtonOptions
 from ancfdae.integrators._potential_split import require_potential_model, require_potential_split
@@ -77,16 +77,26 @@ from ancfdae.integrators.newton_stepper import NewtonStepper
 from ancfdae.integrators.protocol import Quadrature, StepOutcome
 from ancfdae.problem import JacobianBlocks, Model, capabilities
 
-__all__ = ["EnergyCollocation", "SMOOTH_SILENT_STAGES", "ITERATION_MATRICES", "ENERGY_CORRECTIONS",
-           "CORRECTED_NEWTON"]
+__all__ = ["EnergyCollocation", "SMOOTH_SILENT_STAGES", "CORRECTED_SILENT_STAGES", "ITERATION_MATRICES",
+           "ENERGY_CORRECTIONS", "ENERGY_DEFECTS", "CORRECTED_NEWTON"]
 
 #: Silent stages for a potential that is not a polynomial (chosen by measurement, see docs/energy_momentum.md:
 #: one element, 1000 steps of 10 ms, energy drift SQ3D structural 3.6e-11 / 6.6e-14 / 3.8e-14 at k = 4 / 5 / 6,
 #: SQ2D structural 2.0e-13 / 3.1e-14 / 3.0e-14, BE2D 8.4e-14 / 3.9e-14 / 4.3e-14; B3 8 SQ3D, h = 5 ms: 8.5e-14
 #: at k = 5, 9.0e-14 at k = 6).
 SMOOTH_SILENT_STAGES = 5
+#: Silent stages for a non-polynomial potential when the velocity correction removes the potential's own energy
+#: defect (``energy_defect="potential"``): the energy no longer depends on ``k``, only the accuracy, and k = 4 gives
+#: k = 5's tip history (B3 8 SQ3D, h = 5 ms: eps_T 2.924e-6 both, k = 3 3.10e-6; docs/energy_momentum.md).
+CORRECTED_SILENT_STAGES = 4
+#: The split matrix's stiffness is evaluated at ``sigma(JACOBIAN_NODE h)``: modified Newton keeps the matrix over
+#: the rest of the step and the next ones, so ahead of the midpoint (B3 8 SQ3D, h = 5 ms, node 0.5 / 1 / 1.25 / 1.5:
+#: 8.08 / 7.65 / 7.52 / 7.62 iterations and 0.39 / 0.36 / 0.29 / 0.28 refreshes per step; B3 16: 8.13 / 7.76 / 7.58
+#: / 7.63; B2: no change; docs/energy_momentum.md).
+JACOBIAN_NODE = 1.25
 ITERATION_MATRICES = ("split", "exact")
 ENERGY_CORRECTIONS = ("velocity", "newton")
+ENERGY_DEFECTS = ("rule", "potential")
 #: Newton of ``energy_correction="velocity"``: the chapter's relative tolerance, as Lobatto IIIA-3.
 CORRECTED_NEWTON = NewtonOptions(tol=1e-8)
 _S = 2          # fundamental stages: order 4
@@ -103,9 +113,10 @@ class EnergyCollocation(NewtonStepper):
         Step size (> 0); the last step is shortened to end at the bound.
     silent_stages : int or "auto"
         ``k >= 2``, the Gauss nodes of the force projection. ``"auto"``: the declared
-        ``potential_degree`` (at least 2; the energy is then exact), else :data:`SMOOTH_SILENT_STAGES`.
+        ``potential_degree`` (at least 2; the energy is then exact), else :data:`CORRECTED_SILENT_STAGES`
+        with the potential's own defect, :data:`SMOOTH_SILENT_STAGES` without it.
     iteration_matrix : {"split", "exact"}
-        Modified Newton's matrix: ``"split"`` (one stiffness at the midpoint, one complex ``n_dof``
+        Modified Newton's matrix: ``"split"`` (one stiffness, at :data:`JACOBIAN_NODE`; one complex ``n_dof``
         LU; the default, chosen by measurement) or ``"exact"`` (the exact Jacobian, ``2 n_dof``
         real LU). Full Newton always uses the exact Jacobian.
     energy_correction : {"auto", "velocity", "newton"}
@@ -113,6 +124,12 @@ class EnergyCollocation(NewtonStepper):
         removed from ``v1`` (module docstring); ``"newton"``: Newton on to the energy's round-off (the
         only choice with constraints, which a change of ``v1`` alone would break). ``"auto"``: ``"newton"``
         for a constrained model, else ``"velocity"``.
+    energy_defect : {"auto", "rule", "potential"}
+        The defect the velocity correction removes: ``"rule"``, ``sum_i V_i . R_i`` (exact when the ``k``-point
+        rule integrates the potential's power, free); ``"potential"``, the energy balance from the model's
+        ``potential`` (exact for every potential, one call per step; :class:`._energy_correction.PotentialDefect`).
+        ``"auto"``: ``"rule"`` for a declared ``potential_degree <= k`` or ``energy_correction="newton"``, else
+        ``"potential"``.
     newton : NewtonOptions or dict, optional
         Default :data:`CORRECTED_NEWTON` (the chapter's relative tolerance 1e-8) with the velocity
         correction, else :data:`~ancfdae.integrators.energy_momentum.DEFAULT_NEWTON` (relative tolerance
@@ -127,7 +144,7 @@ class EnergyCollocation(NewtonStepper):
     FLOOR_UPDATE = "replace"     # as energy-momentum: the energy identity needs the latest floor
 
     def __init__(self, model: Model, h: float, *, silent_stages: int | str = "auto",
-                 iteration_matrix: str = "split", energy_correction: str = "auto",
+                 iteration_matrix: str = "split", energy_correction: str = "auto", energy_defect: str = "auto",
                  newton: NewtonOptions | dict | None = None) -> None:
         require_potential_model(model, self.name)
         if "constraints" in capabilities(model) and getattr(model, "constraint_degree", None) not in (1, 2):
@@ -147,25 +164,35 @@ class EnergyCollocation(NewtonStepper):
         self.energy_correction = correction
         if correction == "velocity":      # Newton stops at a tolerance, as Lobatto IIIA-3: its floor and update
             self.FLOOR_ROUNDOFF, self.FLOOR_UPDATE = NewtonStepper.FLOOR_ROUNDOFF, NewtonStepper.FLOOR_UPDATE
+        defect = validate.choice("energy_defect", energy_defect, ("auto",) + ENERGY_DEFECTS)
+        if defect == "potential" and correction != "velocity":
+            raise ValueError("`energy_defect` 'potential' is removed by the velocity correction only; got "
+                             f"energy_correction={correction!r}.")
         degree = getattr(model, "potential_degree", None)
         if isinstance(silent_stages, str) and silent_stages == "auto":
-            k = max(_S, int(degree)) if degree is not None else SMOOTH_SILENT_STAGES
+            corrected = correction == "velocity" and defect != "rule"
+            k = max(_S, int(degree)) if degree is not None else (
+                CORRECTED_SILENT_STAGES if corrected else SMOOTH_SILENT_STAGES)
         elif isinstance(silent_stages, (int, np.integer)) and not isinstance(silent_stages, bool) \
                 and silent_stages >= _S:
             k = int(silent_stages)
         else:
             raise ValueError(f"`silent_stages` must be 'auto' or an integer >= {_S}, got {silent_stages!r}.")
         self.silent_stages = k
+        if defect == "auto":
+            defect = "rule" if correction != "velocity" or (degree is not None and int(degree) <= k) else "potential"
+        self.energy_defect = defect
         self.iteration_matrix = validate.choice("iteration_matrix", iteration_matrix, ITERATION_MATRICES)
         self._co = hbvm_coefficients(k, _S)
         self._loads = hbvm_coefficients(_S, _S)      # the 2-point Gauss rule of the loads
-        self._pattern = None
+        self._wJ = self._co.position_weights(JACOBIAN_NODE)
+        self._exact_matrix = ExactMatrix(self._co, self._loads)
 
     def options(self) -> dict:
         """The options as a JSON-able dict: ``h``, the Newton options, ``silent_stages``, ``iteration_matrix``."""
         o = super().options()
         o.update(silent_stages=self.silent_stages, iteration_matrix=self.iteration_matrix,
-                 energy_correction=self.energy_correction)
+                 energy_correction=self.energy_correction, energy_defect=self.energy_defect)
         return o
 
     def _setup(self):
@@ -193,6 +220,8 @@ class EnergyCollocation(NewtonStepper):
         self._Mcsr = sp.csr_matrix(m.jacobian(self.t, self.q, z, z).M)   # the mass on the stiffness' pattern
         self._prev = None          # (h, Y) of the last step: the predictor
         self._correct = VelocityCorrection(m, self._M)
+        self._balance = PotentialDefect(m, self._M) if self.energy_defect == "potential" else None
+        self._last_loads = (None, None)       # (x, loads at its nodes) of the last residual: the step's work
 
     def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model) -> None:
         """Carry on from a state a model event changed (the predictor is dropped, the model rebound)."""
@@ -205,20 +234,10 @@ class EnergyCollocation(NewtonStepper):
         return t0 + co.c * h, self.q[:, None] + np.outer(h * self.v, co.c) + Y @ co.Wq.T
 
     def _forces(self, t0, h, Y):
-        """``sum_l BP[i, l] (grad P - f_nc)(sigma_l)``: the conservative force at the ``k`` nodes, the
-        loads at the 2 Gauss nodes (the Gauss method's own rule: order 4, and the work of the loads is
-        that rule's, handed to the monitors)."""
-        return self._force_terms(t0, h)(Y)
-
-    def _force_terms(self, t0, h):
-        """:meth:`_forces` of the step from ``(t0, q, v)`` as a function of ``Y`` alone (see :meth:`_stage_values`)."""
-        values, BPT, BlT = self._stage_values(t0, h), self._co.BP.T.copy(), self._loads.BP.T.copy()
-
-        def forces(Y):
-            G, F = values(Y)
-            return G @ BPT - F @ BlT
-
-        return forces
+        """``sum_l BP[i, l] (grad P - f_nc)(sigma_l)``: the conservative force at the ``k`` nodes, the loads at
+        the 2 Gauss nodes (the Gauss method's own rule: order 4; the loads' work is that rule's, for the monitors)."""
+        G, F = self._stage_values(t0, h)(Y)
+        return G @ self._co.BP.T - F @ self._loads.BP.T
 
     def _stage_values(self, t0, h):
         """``values(Y) -> (G, F)``: ``grad P`` at the ``k`` nodes (n_dof, k) and ``f_nc`` at the 2 Gauss nodes
@@ -256,26 +275,7 @@ class EnergyCollocation(NewtonStepper):
 
     def _assemble(self, H, Kf, h):
         """``delta_im M / h^2 + sum_l C[i, m, l] H[l] - sum_j Cnc[i, m, j] Kf[j]`` as an interleaved CSR."""
-        co, ld, n = self._co, self._loads, self.n_dof
-        mats = [sp.csr_matrix(A) for A in list(H) + list(Kf)] + [self._Mcsr]
-        weights = np.concatenate([co.C, -ld.C, np.eye(_S)[:, :, None] / (h * h)], axis=2)   # (s, s, k + 2 + 1)
-        A0 = mats[0]
-        if all(A.indptr is A0.indptr and A.indices is A0.indices for A in mats) or all(
-                np.array_equal(A.indptr, A0.indptr) and np.array_equal(A.indices, A0.indices) for A in mats):
-            if self._pattern is None or not np.array_equal(self._pattern[0], A0.indptr) \
-                    or not np.array_equal(self._pattern[1], A0.indices):
-                self._pattern = (A0.indptr, A0.indices, *interleaved_pattern(A0.indptr, A0.indices, n, _S))
-            _, _, order, big_indices, big_indptr = self._pattern
-            vals = np.einsum("iml,le->eim", weights, np.stack([A.data for A in mats]))   # (nnz, s, s)
-            return sp.csr_matrix((vals.ravel()[order], big_indices, big_indptr), shape=(_S * n, _S * n))
-        out = None
-        for i in range(_S):
-            for j in range(_S):
-                B = sum(w * A for w, A in zip(weights[i, j], mats))
-                E = sp.csr_matrix(([1.0], ([i], [j])), shape=(_S, _S))
-                term = sp.kron(B, E, format="csr")
-                out = term if out is None else out + term
-        return out.tocsr()
+        return self._exact_matrix(H, Kf, self._Mcsr, h)
 
     def stage_equations(self, t0: float, h: float, split: list) -> tuple:
         """The step's equations from the current state: ``(residual(x), jacobian(x))`` of the unknowns
@@ -283,7 +283,7 @@ class EnergyCollocation(NewtonStepper):
         ``split[0]`` is true, else the exact Jacobian."""
         co, n, model = self._co, self.n_dof, self.model
         q0, v0 = self.q, self.v
-        M, ih2 = self._M, 1.0 / (h * h)
+        M, ih2, wJ = self._M, 1.0 / (h * h), self._wJ
         zn = np.zeros(n)
 
         values, BPT, BlT = self._stage_values(t0, h), co.BP.T.copy(), self._loads.BP.T.copy()
@@ -292,6 +292,7 @@ class EnergyCollocation(NewtonStepper):
         def residual(x):      # M Y / h^2 + G BP^T - F BL^T in one compiled call
             Y = x.reshape(n, _S)
             G, F = values(Y)
+            self._last_loads = (x, F)
             R = np.empty((n, _S))
             stage_residual(Y, np.asarray(G, dtype=float), BPT, np.asarray(F, dtype=float), BlT, *mass, ih2, R)
             return R.ravel()
@@ -299,8 +300,8 @@ class EnergyCollocation(NewtonStepper):
         def jacobian(x):
             Y = x.reshape(n, _S)
             if split[0]:
-                qm = q0 + 0.5 * h * v0 + Y @ co.mid
-                blk = model.jacobian(t0 + 0.5 * h, qm, zn, zn)
+                qm = q0 + JACOBIAN_NODE * h * v0 + Y @ wJ
+                blk = model.jacobian(t0 + JACOBIAN_NODE * h, qm, zn, zn)
                 if blk.same_pattern:
                     K = blk.K
                     blk = JacobianBlocks(K, sp.csr_matrix((np.zeros_like(K.data), K.indices, K.indptr),
@@ -327,7 +328,7 @@ class EnergyCollocation(NewtonStepper):
         v1 = v0 + Y[:, 0] / h
         if r is not None:
             R = r.reshape(n, _S)
-            v1c = self._correct(h, v1, R[:, 0], energy_defect(Y, R, co.X, h * v0))
+            v1c = self._correct(h, v1, R[:, 0], self._defect(t0, h, out.x, R, q1, v1))
             if v1c is None:     # a body near rest cannot carry the defect in its velocity: iterate to round-off
                 residual, jacobian = self.stage_equations(t0, h, split)
                 out = self._solve(residual, jacobian, out.x, accept=round_off_test(self._M, co.X, h, v0))
@@ -336,6 +337,9 @@ class EnergyCollocation(NewtonStepper):
                 Y = out.x.reshape(n, _S)
                 q1 = q0 + (h * v0 + Y @ co.q_end)
                 v1c = v0 + Y[:, 0] / h
+                if self._balance is not None:     # the rule's own error is left: removed where the velocity can
+                    v1r = self._correct(h, v1c, np.zeros(n), self._defect(t0, h, out.x, None, q1, v1c))
+                    v1c = v1c if v1r is None else v1r
             v1 = v1c
         # The acceleration at t1 (interpolation, the next step's first guess): M a1 = -r(t1, q1, v1, 0).
         a1 = self._Mlu.solve(-np.asarray(model.residual(t1, q1, v1, np.zeros_like(q1)), dtype=float))
@@ -366,6 +370,19 @@ class EnergyCollocation(NewtonStepper):
         if not (out.converged and velocity):
             return out, None
         return out, (last["r"] if last.get("x") is out.x else residual(out.x))
+
+    def _defect(self, t0, h, x, R, q1, v1):
+        """The energy defect the velocity correction removes (``energy_defect``; ``R``: the residual at ``x``)."""
+        Y, v0 = x.reshape(self.n_dof, _S), self.v
+        if self._balance is None:
+            return energy_defect(Y, R, self._co.X, h * v0)
+        ld = self._loads
+        x_F, F = self._last_loads            # the loads at x's nodes when its residual was the last one evaluated
+        if x_F is not x:
+            ts, Q = self._nodes(t0, h, Y, ld)
+            F = np.column_stack([self.model.nonconservative_force(t, Q[:, j], False)[0] for j, t in enumerate(ts)])
+        hV = h * v0[:, None] + Y @ ld.Wd.T     # h sigma' at the loads' nodes
+        return self._balance(t0, self.q, v0, t0 + h, q1, v1, float(np.sum(F * hV, axis=0) @ ld.b))
 
     def _predict(self, h):
         """The previous step's acceleration polynomial continued (same ``h``), else ``Y = (h^2 a, 0)``."""

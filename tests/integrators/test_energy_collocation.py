@@ -30,7 +30,7 @@ def run(model, h, t_end, monitor=None, **options):
 
 
 def test_coefficients():
-    """Catches: a wrong X (closed form of Brugnano et al.), projection, predictor or midpoint row."""
+    """Catches: a wrong X (closed form of Brugnano et al.), projection, predictor, midpoint row or position weights."""
     for k in (2, 3, 4, 6):
         co = hbvm_coefficients(k, 2)
         xi = 1.0 / (2.0 * np.sqrt(3.0))
@@ -43,6 +43,10 @@ def test_coefficients():
     pos = lambda c: c ** 2 / 2 + c ** 3 / 3                   # int_0^c int_0^x (1 + 2 y) dy dx
     assert (Y @ co.q_end)[0] == pytest.approx(pos(1.0), abs=1e-15)
     assert (Y @ co.mid)[0] == pytest.approx(pos(0.5), abs=1e-15)
+    # sigma is the quadratic through sigma(0) = 0, mid and end; continued past the step (the frozen stiffness' node)
+    quad = np.polynomial.Polynomial.fit([0.0, 0.5, 1.0], [0.0, pos(0.5), pos(1.0)], 2)
+    for c in (0.5, 1.0, 1.25, 0.3):
+        assert (Y @ co.position_weights(c))[0] == pytest.approx(quad(c), abs=1e-14)
     # continued over the next step: a(1 + c) = 3 + 2 c
     assert np.abs(Y @ co.predictor.T - [[4.0, 2.0 / (2 * np.sqrt(3.0))]]).max() <= 1e-14
     assert legendre01(1)(1.0) == pytest.approx(np.sqrt(3.0))
@@ -164,7 +168,8 @@ def test_free_motion_energy_constant_every_element(name, n, kw):
     10 ms; energy constant to 1e-12 relative at every step (the 10^4-step runs: ``python -m
     benchmarks.energy_collocation long``).
 
-    Catches: too few silent stages for a formulation ('auto'), a Newton stop above round-off.
+    Catches: too few silent stages for a formulation ('auto'), a Newton stop above round-off, a
+    non-polynomial potential left to the rule's defect (SQ3D structural, k = 4: 3.6e-11 over 1000 steps).
     """
     t_load = 0.3 if name.endswith("2D") else 0.4
     beam = b2(name, n, T=t_load, **kw) if name.endswith("2D") else b3(name, n, t_load=t_load, **kw)
@@ -173,7 +178,8 @@ def test_free_motion_energy_constant_every_element(name, n, kw):
     assert E.size >= FREE_STEPS
     assert np.ptp(E) <= 1e-12 * np.abs(E).max(), np.ptp(E) / np.abs(E).max()
     polynomial = name.startswith("SQ") and "continuum" in kw.get("formulation", "")
-    assert res.options["silent_stages"] == (4 if polynomial else 5)
+    assert res.options["silent_stages"] == 4
+    assert res.options["energy_defect"] == ("rule" if polynomial else "potential")
 
 
 ROUNDOFF_STEPS = 300
@@ -201,17 +207,21 @@ def test_energy_at_round_off_over_hundreds_of_steps(name, kw, bound, correction)
 
 
 def test_too_few_silent_stages_lose_the_energy():
-    """SQ3D continuum (quartic P) with k = 3 < 4 nodes: the energy is no longer exact (the docstring's rule).
+    """SQ3D continuum (quartic P) with k = 3 < 4 nodes: the rule's defect no longer is the energy's (the
+    docstring's rule), and the potential's own defect (``"auto"`` at k = 3) keeps it exact again.
 
-    Catches: a test above that would pass whatever k (a model or load that does not excite the nonlinearity).
+    Catches: a test above that would pass whatever k (a model or load that does not excite the nonlinearity);
+    an ``"auto"`` defect that trusts a rule too short for the declared degree.
     """
-    drift = {}
-    for k in (3, 4):
+    drift, chosen = {}, {}
+    for k, defect in ((3, "rule"), (4, "auto"), (3, "auto")):
         beam = b3("SQ3D", 1, t_load=0.4, formulation="continuum")
-        res = run(beam, 2e-2, 1.2, silent_stages=k)
+        res = run(beam, 2e-2, 1.2, silent_stages=k, energy_defect=defect)
         E = total_energy(beam, list(zip(res.t, res.q, res.v)), 0.4)
-        drift[k] = np.ptp(E) / np.abs(E).max()
-    assert drift[4] <= 1e-12 and drift[3] >= 1e3 * drift[4], drift
+        drift[k, defect], chosen[k, defect] = np.ptp(E) / np.abs(E).max(), res.options["energy_defect"]
+    assert drift[4, "auto"] <= 1e-12 and drift[3, "rule"] >= 1e3 * drift[4, "auto"], drift
+    assert drift[3, "auto"] <= 1e-12, drift
+    assert chosen == {(3, "rule"): "rule", (4, "auto"): "rule", (3, "auto"): "potential"}, chosen
 
 
 def test_energy_balance_with_loads_and_linear_momentum():
@@ -242,6 +252,10 @@ def test_bad_input_refused_with_reason():
             EnergyCollocation(beam, 1e-2, silent_stages=bad)
     with pytest.raises(ValueError, match="iteration_matrix"):
         EnergyCollocation(beam, 1e-2, iteration_matrix="lu")
+    with pytest.raises(ValueError, match="energy_defect"):
+        EnergyCollocation(beam, 1e-2, energy_defect="exact")
+    with pytest.raises(ValueError, match="energy_defect.*velocity correction only"):
+        EnergyCollocation(beam, 1e-2, energy_correction="newton", energy_defect="potential")
     with pytest.raises(ValueError, match="h"):
         EnergyCollocation(beam, 0.0)
     res = simulate(SpringChain(damping=0.5), (0.0, 1.0), "energy-collocation", h=1e-2)
