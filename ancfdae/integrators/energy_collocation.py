@@ -85,21 +85,17 @@ __all__ = ["EnergyCollocation", "SMOOTH_SILENT_STAGES", "CORRECTED_SILENT_STAGES
 #: SQ2D structural 2.0e-13 / 3.1e-14 / 3.0e-14, BE2D 8.4e-14 / 3.9e-14 / 4.3e-14; B3 8 SQ3D, h = 5 ms: 8.5e-14
 #: at k = 5, 9.0e-14 at k = 6).
 SMOOTH_SILENT_STAGES = 5
-#: Silent stages for a non-polynomial potential when the velocity correction removes the potential's own energy
-#: defect (``energy_defect="potential"``): the energy no longer depends on ``k``, only the accuracy, and k = 4 gives
-#: k = 5's tip history (B3 8 SQ3D, h = 5 ms: eps_T 2.924e-6 both, k = 3 3.10e-6; docs/energy_momentum.md).
+#: Silent stages for a non-polynomial potential with ``energy_defect="potential"``: k then sets the accuracy alone
+#: (B3 8 SQ3D, h = 5 ms: eps_T 2.924e-6 at k = 4 and 5, 3.10e-6 at k = 3; docs/energy_momentum.md).
 CORRECTED_SILENT_STAGES = 4
-#: The split matrix's stiffness is evaluated at ``sigma(JACOBIAN_NODE h)``: modified Newton keeps the matrix over
-#: the rest of the step and the next ones, so ahead of the midpoint (B3 8 SQ3D, h = 5 ms, node 0.5 / 1 / 1.25 / 1.5:
-#: 8.08 / 7.65 / 7.52 / 7.62 iterations and 0.39 / 0.36 / 0.29 / 0.28 refreshes per step; B3 16: 8.13 / 7.76 / 7.58
-#: / 7.63; B2: no change; docs/energy_momentum.md).
+#: The split matrix's stiffness at ``sigma(JACOBIAN_NODE h)``, ahead of the midpoint: the matrix serves the next steps
+#: too (B3 8 SQ3D, h = 5 ms, node 0.5 / 1 / 1.25 / 1.5: 8.08 / 7.65 / 7.52 / 7.62 it/step; docs/energy_momentum.md).
 JACOBIAN_NODE = 1.25
 ITERATION_MATRICES = ("split", "exact")
 ENERGY_CORRECTIONS = ("velocity", "newton")
 ENERGY_DEFECTS = ("rule", "potential")
-#: Newton of ``energy_correction="velocity"``: the chapter's relative tolerance, as Lobatto IIIA-3; the matrix refreshed
-#: at rate 0.2 (B3 8 SQ3D, h = 5 ms, rate 0.3 / 0.2 / 0.15: 7.52 / 6.65 / 6.30 iterations, 0.29 / 0.40 / 0.43 refreshes
-#: per step; B2 4 BE2D 5.10 / 4.81 iterations; Lobatto IIIA-3 at 0.2: 6.49 and 0.65, slower than at its 0.3).
+#: Newton of ``energy_correction="velocity"``: the chapter's relative tolerance, as Lobatto IIIA-3; refresh at rate 0.2
+#: (B3 8 SQ3D: 6.65 against 7.52 it/step at 0.3, 0.40 against 0.29 refreshes; docs/energy_momentum.md).
 CORRECTED_NEWTON = NewtonOptions(tol=1e-8, contraction=0.2)
 _S = 2          # fundamental stages: order 4
 
@@ -127,11 +123,9 @@ class EnergyCollocation(NewtonStepper):
         only choice with constraints, which a change of ``v1`` alone would break). ``"auto"``: ``"newton"``
         for a constrained model, else ``"velocity"``.
     energy_defect : {"auto", "rule", "potential"}
-        The defect the velocity correction removes: ``"rule"``, ``sum_i V_i . R_i`` (exact when the ``k``-point
-        rule integrates the potential's power, free); ``"potential"``, the energy balance from the model's
-        ``potential`` (exact for every potential, one call per step; :class:`._energy_correction.PotentialDefect`).
-        ``"auto"``: ``"rule"`` for a declared ``potential_degree <= k`` or ``energy_correction="newton"``, else
-        ``"potential"``.
+        The defect the velocity correction removes: ``"rule"``, ``sum_i V_i . R_i`` (exact where the ``k``-point rule
+        integrates the potential's power; free) or ``"potential"``, the balance from the model's ``potential`` (exact
+        always; one call per step). "auto": "rule" if ``potential_degree <= k`` or with "newton", else "potential".
     newton : NewtonOptions or dict, optional
         Default :data:`CORRECTED_NEWTON` (the chapter's relative tolerance 1e-8, refresh at rate 0.2) with the velocity
         correction, else :data:`~ancfdae.integrators.energy_momentum.DEFAULT_NEWTON` (relative tolerance
@@ -236,10 +230,20 @@ class EnergyCollocation(NewtonStepper):
         return t0 + co.c * h, self.q[:, None] + np.outer(h * self.v, co.c) + Y @ co.Wq.T
 
     def _forces(self, t0, h, Y):
-        """``sum_l BP[i, l] (grad P - f_nc)(sigma_l)``: the conservative force at the ``k`` nodes, the loads at
-        the 2 Gauss nodes (the Gauss method's own rule: order 4; the loads' work is that rule's, for the monitors)."""
-        G, F = self._stage_values(t0, h)(Y)
-        return G @ self._co.BP.T - F @ self._loads.BP.T
+        """``sum_l BP[i, l] (grad P - f_nc)(sigma_l)``: the conservative force at the ``k`` nodes, the
+        loads at the 2 Gauss nodes (the Gauss method's own rule: order 4, and the work of the loads is
+        that rule's, handed to the monitors)."""
+        return self._force_terms(t0, h)(Y)
+
+    def _force_terms(self, t0, h):
+        """:meth:`_forces` of the step from ``(t0, q, v)`` as a function of ``Y`` alone (see :meth:`_stage_values`)."""
+        values, BPT, BlT = self._stage_values(t0, h), self._co.BP.T.copy(), self._loads.BP.T.copy()
+
+        def forces(Y):
+            G, F = values(Y)
+            return G @ BPT - F @ BlT
+
+        return forces
 
     def _stage_values(self, t0, h):
         """``values(Y) -> (G, F)``: ``grad P`` at the ``k`` nodes (n_dof, k) and ``f_nc`` at the 2 Gauss nodes
@@ -375,16 +379,15 @@ class EnergyCollocation(NewtonStepper):
 
     def _defect(self, t0, h, x, R, q1, v1):
         """The energy defect the velocity correction removes (``energy_defect``; ``R``: the residual at ``x``)."""
-        Y, v0 = x.reshape(self.n_dof, _S), self.v
+        Y, v0, ld = x.reshape(self.n_dof, _S), self.v, self._loads
         if self._balance is None:
             return energy_defect(Y, R, self._co.X, h * v0)
-        ld = self._loads
-        x_F, F = self._last_loads            # the loads at x's nodes when its residual was the last one evaluated
+        x_F, F = self._last_loads            # the loads at x's nodes when x's residual was the last one evaluated
         if x_F is not x:
             ts, Q = self._nodes(t0, h, Y, ld)
             F = np.column_stack([self.model.nonconservative_force(t, Q[:, j], False)[0] for j, t in enumerate(ts)])
-        hV = h * v0[:, None] + Y @ ld.Wd.T     # h sigma' at the loads' nodes
-        return self._balance(t0, self.q, v0, t0 + h, q1, v1, float(np.sum(F * hV, axis=0) @ ld.b))
+        work = float(np.sum(F * (h * v0[:, None] + Y @ ld.Wd.T), axis=0) @ ld.b)     # F . h sigma' by the loads' rule
+        return self._balance(t0, self.q, v0, t0 + h, q1, v1, work)
 
     def _predict(self, h):
         """The previous step's acceleration polynomial continued (same ``h``), else ``Y = (h^2 a, 0)``."""
