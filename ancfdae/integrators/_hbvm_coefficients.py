@@ -83,12 +83,6 @@ class HBVMCoefficients:
     mid: np.ndarray
 
 
-    def position_weights(self, c: float) -> np.ndarray:
-        """``w`` with ``sigma(c h) = q0 + c h v0 + w . Y`` at any ``c``, past the step too (the polynomial
-        continued); ``position_weights(1) = q_end``, ``position_weights(0.5) = mid``."""
-        return np.array([legendre01(j).integ()(c) for j in range(self.s)]) @ self.X
-
-
 @lru_cache(maxsize=None)
 def hbvm_coefficients(k: int, s: int = 2) -> HBVMCoefficients:
     """The coefficients of HBVM(k, s), ``k >= s >= 1``, from exact polynomial integrals.

@@ -48,8 +48,7 @@ the solver's ``accept``). The exact Jacobian of the
 stage equations is ``dR_i/dY_m = delta_im M / h^2 + sum_l C[i, m, l] H_l - sum_j C'[i, m, j] Kf_j`` with
 the Hessian ``H_l`` of ``P`` at every node and the load tangent ``Kf_j`` at the loads' nodes (real,
 ``2 n_dof`` square, interleaved, banded). The default iteration matrix freezes
-one stiffness ``K`` of the residual, at ``sigma(JACOBIAN_NODE h)`` (ahead of the midpoint: the matrix serves the
-next steps too): then ``sum_l C[:, :, l] = X^2`` and the matrix splits in the
+one stiffness ``K`` of the residual, at the step's midpoint: then ``sum_l C[:, :, l] = X^2`` and the matrix splits in the
 eigenbasis of ``X`` (eigenvalues ``1/4 +- i / sqrt(48)``, those of Lobatto IIIA-3's implicit block)
 into one complex ``n_dof`` square banded LU, as Lobatto IIIA-3 (:class:`~ancfdae.integrators._linsolve.StageMatrix`).
 A step that fails with it is retried with the exact Jacobian; full Newton uses the exact Jacobian.
@@ -88,14 +87,11 @@ SMOOTH_SILENT_STAGES = 5
 #: Silent stages for a non-polynomial potential with ``energy_defect="potential"``: k then sets the accuracy alone
 #: (B3 8 SQ3D, h = 5 ms: eps_T 2.924e-6 at k = 4 and 5, 3.10e-6 at k = 3; docs/energy_momentum.md).
 CORRECTED_SILENT_STAGES = 4
-#: The split matrix's stiffness at ``sigma(JACOBIAN_NODE h)``, ahead of the midpoint: the matrix serves the next steps
-#: too (B3 8 SQ3D, h = 5 ms, node 0.5 / 1 / 1.25 / 1.5: 8.08 / 7.65 / 7.52 / 7.62 it/step; docs/energy_momentum.md).
-JACOBIAN_NODE = 1.25
 ITERATION_MATRICES = ("split", "exact")
 ENERGY_CORRECTIONS = ("velocity", "newton")
 ENERGY_DEFECTS = ("rule", "potential")
 #: Newton of ``energy_correction="velocity"``: the chapter's relative tolerance, as Lobatto IIIA-3; refresh at rate 0.2
-#: (B3 8 SQ3D: 6.65 against 7.52 it/step at 0.3, 0.40 against 0.29 refreshes; docs/energy_momentum.md).
+#: (B3 8 SQ3D, h = 5 ms: 7.14 against 8.08 it/step at 0.3, 0.70 against 0.39 refreshes; docs/energy_momentum.md).
 CORRECTED_NEWTON = NewtonOptions(tol=1e-8, contraction=0.2)
 _S = 2          # fundamental stages: order 4
 
@@ -114,7 +110,7 @@ class EnergyCollocation(NewtonStepper):
         ``potential_degree`` (at least 2; the energy is then exact), else :data:`CORRECTED_SILENT_STAGES`
         with the potential's own defect, :data:`SMOOTH_SILENT_STAGES` without it.
     iteration_matrix : {"split", "exact"}
-        Modified Newton's matrix: ``"split"`` (one stiffness, at :data:`JACOBIAN_NODE`; one complex ``n_dof``
+        Modified Newton's matrix: ``"split"`` (one stiffness at the midpoint, one complex ``n_dof``
         LU; the default, chosen by measurement) or ``"exact"`` (the exact Jacobian, ``2 n_dof``
         real LU). Full Newton always uses the exact Jacobian.
     energy_correction : {"auto", "velocity", "newton"}
@@ -181,7 +177,6 @@ class EnergyCollocation(NewtonStepper):
         self.iteration_matrix = validate.choice("iteration_matrix", iteration_matrix, ITERATION_MATRICES)
         self._co = hbvm_coefficients(k, _S)
         self._loads = hbvm_coefficients(_S, _S)      # the 2-point Gauss rule of the loads
-        self._wJ = self._co.position_weights(JACOBIAN_NODE)
         self._exact_matrix = ExactMatrix(self._co, self._loads)
 
     def options(self) -> dict:
@@ -289,7 +284,7 @@ class EnergyCollocation(NewtonStepper):
         ``split[0]`` is true, else the exact Jacobian."""
         co, n, model = self._co, self.n_dof, self.model
         q0, v0 = self.q, self.v
-        M, ih2, wJ = self._M, 1.0 / (h * h), self._wJ
+        M, ih2 = self._M, 1.0 / (h * h)
         zn = np.zeros(n)
 
         values, BPT, BlT = self._stage_values(t0, h), co.BP.T.copy(), self._loads.BP.T.copy()
@@ -306,8 +301,8 @@ class EnergyCollocation(NewtonStepper):
         def jacobian(x):
             Y = x.reshape(n, _S)
             if split[0]:
-                qm = q0 + JACOBIAN_NODE * h * v0 + Y @ wJ
-                blk = model.jacobian(t0 + JACOBIAN_NODE * h, qm, zn, zn)
+                qm = q0 + 0.5 * h * v0 + Y @ co.mid
+                blk = model.jacobian(t0 + 0.5 * h, qm, zn, zn)
                 if blk.same_pattern:
                     K = blk.K
                     blk = JacobianBlocks(K, sp.csr_matrix((np.zeros_like(K.data), K.indices, K.indptr),
