@@ -11,9 +11,11 @@
 ``python -m benchmarks.energy_collocation long [--steps 10000] [--elements 1] [--silent-stages auto]``
     energy drift over ``--steps`` free steps (h = 10 ms) after a short load, every constant-mass
     element and formulation (as ``tests/integrators/test_energy_collocation.py`` with fewer steps).
-``python -m benchmarks.energy_collocation ratio --problem B3-8 [--h 5e-3] [--t-end 5] [--reps 3]``
-    CPU time of energy-collocation over Lobatto IIIA-3's at one step: medians of ``--reps`` runs of each,
-    interleaved in one process (equal h is equal accuracy: see ``wp``).
+``python -m benchmarks.energy_collocation ratio --problem B3-8 [--h 5e-3] [--t-end 5] [--reps 3] [--methods ...]``
+    CPU time of energy-collocation (and any other ``--methods`` label) over Lobatto IIIA-3's at one step: medians
+    of ``--reps`` runs of each, interleaved in one process, and the median of the per-repetition ratios (equal h is
+    equal accuracy: see ``wp``). ``energy-collocation-k5-rule``: the defaults before the potential's defect (k = 5
+    for smooth potentials, the rule's defect, refresh at rate 0.3).
 ``python -m benchmarks.energy_collocation stages [--problem B3-8] [--h 1e-2] [--t-end 10]``
     the energy's spread after the load against the number of silent stages ``k``.
 
@@ -66,6 +68,10 @@ def method_of(label, model, h):
         return dict(method="energy-collocation", h=h)
     if label == "energy-collocation-newton":          # Newton to the energy's round-off, no velocity correction
         return dict(method="energy-collocation", h=h, energy_correction="newton")
+    if label == "energy-collocation-k5-rule":
+        k = "auto" if getattr(model, "potential_degree", None) is not None else 5
+        return dict(method="energy-collocation", h=h, silent_stages=k, energy_defect="rule",
+                    newton=NewtonOptions(tol=1e-8))
     if label == "energy-collocation-exact":
         return dict(method="energy-collocation", h=h, iteration_matrix="exact")
     if label.startswith("energy-collocation-k"):
@@ -200,10 +206,11 @@ def long_runs(a):
 
 def ratio(a):
     build = PROBLEMS[a.problem][0]
-    for m in ("lobatto3", "energy-collocation"):                 # compile before timing
+    labels = ["lobatto3"] + [m for m in (a.methods or ["energy-collocation"]) if m != "lobatto3"]
+    for m in labels:                                             # compile before timing
         model = build()
         simulate(model, (0.0, 0.05), **method_of(m, model, a.h), monitors=[EnergyMonitor()])
-    cpu = {"lobatto3": [], "energy-collocation": []}
+    cpu = {m: [] for m in labels}
     for _ in range(a.reps):
         for m in cpu:
             model = build()
@@ -211,12 +218,14 @@ def ratio(a):
             res = simulate(model, (0.0, a.t_end), **method_of(m, model, a.h), monitors=[EnergyMonitor()])
             cpu[m].append(time.process_time() - c0)
             st = res.stats
-            print(f"{m:<20}{'ok' if res.success else 'FAILED'}  CPU {cpu[m][-1]:6.2f} s  it/step "
+            print(f"{m:<26}{'ok' if res.success else 'FAILED'}  CPU {cpu[m][-1]:6.2f} s  it/step "
                   f"{st['newton_iterations'] / st['steps']:.2f}  LU/step {st['factorizations'] / st['steps']:.3f}",
                   flush=True)
-    lo, ec = np.median(cpu["lobatto3"]), np.median(cpu["energy-collocation"])
-    print(f"{a.problem} h = {a.h:g}, [0, {a.t_end:g}] s: median CPU Lobatto IIIA-3 {lo:.2f} s, energy-collocation "
-          f"{ec:.2f} s, ratio {ec / lo:.2f}")
+    lo = np.median(cpu["lobatto3"])
+    for m in labels[1:]:
+        ec, pairs = np.median(cpu[m]), np.median(np.array(cpu[m]) / np.array(cpu["lobatto3"]))
+        print(f"{a.problem} h = {a.h:g}, [0, {a.t_end:g}] s: median CPU Lobatto IIIA-3 {lo:.2f} s, {m} "
+              f"{ec:.2f} s, ratio {ec / lo:.2f} (median of the {a.reps} pairs' ratios {pairs:.2f})")
 
 
 def stages(a):

@@ -25,6 +25,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ancfdae.integrators._csr_numba import csr_matvec
+from ancfdae.integrators._hbvm_numba import kinetic_work
 
 __all__ = ["VelocityCorrection", "PotentialDefect", "MAX_SCALING", "ENERGY_DEFECT", "energy_defect", "round_off_test",
            "keep_residual"]
@@ -111,30 +112,36 @@ class PotentialDefect:
     the rule's error, ``O(h^(2k+1))`` per step. This defect is the balance itself, exact for every potential,
     at the price of one :meth:`~ancfdae.problem.PotentialModel.potential` call per step (``P(q0)`` is the
     previous step's ``P(q1)`` while the state is that step's). ``W`` is the loads' work by the step's own rule
-    (the one handed to the monitors), so ``T + U + V - W_ext`` is what the correction keeps.
+    (the one handed to the monitors), so ``T + U + V - W_ext`` is what the correction keeps; ``T`` and ``W`` in
+    one compiled pass (:func:`~ancfdae.integrators._hbvm_numba.kinetic_work`).
 
     Parameters
     ----------
     model : PotentialModel
     M : sparse matrix
         The constant mass matrix.
+    loads : HBVMCoefficients
+        The loads' rule (nodes, ``Wd``, weights ``b``).
     """
 
-    def __init__(self, model, M) -> None:
+    def __init__(self, model, M, loads) -> None:
         M = sp.csr_matrix(M)
-        self._model, self._M = model, (M.indptr, M.indices, M.data)
+        self._model, self._M = model, (M.data, M.indptr, M.indices)
+        self._WdT, self._b = np.ascontiguousarray(loads.Wd.T), np.ascontiguousarray(loads.b)
         self._last = (None, 0.0)          # (q1, P(q1)) of the last call: P(q0) of the next step
 
-    def __call__(self, t0: float, q0: np.ndarray, v0: np.ndarray, t1: float, q1: np.ndarray, v1: np.ndarray,
-                 work: float) -> float:
-        """``D`` of the step ``(t0, q0, v0) -> (t1, q1, v1)`` whose loads did the work ``work``."""
-        model, M = self._model, self._M
+    def __call__(self, t0: float, h: float, q0: np.ndarray, v0: np.ndarray, q1: np.ndarray, v1: np.ndarray,
+                 Y: np.ndarray, F: np.ndarray) -> float:
+        """``D`` of the step ``(t0, q0, v0) -> (t0 + h, q1, v1)`` with unknowns ``Y`` and loads ``F`` at the loads'
+        nodes (n_dof, 2)."""
+        model = self._model
         last_q, P0 = self._last
         if last_q is not q0:
             P0 = float(model.potential(t0, q0))
-        P1 = float(model.potential(t1, q1))
+        P1 = float(model.potential(t0 + h, q1))
         self._last = (q1, P1)
-        return (0.5 * float(v1 @ csr_matvec(*M, v1)) + P1) - (0.5 * float(v0 @ csr_matvec(*M, v0)) + P0) - work
+        dT, W = kinetic_work(*self._M, v0, v1, np.ascontiguousarray(F, dtype=float), Y, self._WdT, self._b, h)
+        return dT + (P1 - P0) - W
 
 
 def energy_defect(Y: np.ndarray, R: np.ndarray, X: np.ndarray, hv: np.ndarray) -> float:

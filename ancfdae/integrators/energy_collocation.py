@@ -211,7 +211,7 @@ class EnergyCollocation(NewtonStepper):
         self._Mcsr = sp.csr_matrix(m.jacobian(self.t, self.q, z, z).M)   # the mass on the stiffness' pattern
         self._prev = None          # (h, Y) of the last step: the predictor
         self._correct = VelocityCorrection(m, self._M)
-        self._balance = PotentialDefect(m, self._M) if self.energy_defect == "potential" else None
+        self._balance = PotentialDefect(m, self._M, self._loads) if self.energy_defect == "potential" else None
         self._last_loads = (None, None)       # (x, loads at its nodes) of the last residual: the step's work
 
     def restart(self, t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, model: Model) -> None:
@@ -381,8 +381,7 @@ class EnergyCollocation(NewtonStepper):
         if x_F is not x:
             ts, Q = self._nodes(t0, h, Y, ld)
             F = np.column_stack([self.model.nonconservative_force(t, Q[:, j], False)[0] for j, t in enumerate(ts)])
-        work = float(np.sum(F * (h * v0[:, None] + Y @ ld.Wd.T), axis=0) @ ld.b)     # F . h sigma' by the loads' rule
-        return self._balance(t0, self.q, v0, t0 + h, q1, v1, work)
+        return self._balance(t0, h, self.q, v0, q1, v1, Y, F)
 
     def _predict(self, h):
         """The previous step's acceleration polynomial continued (same ``h``), else ``Y = (h^2 a, 0)``."""
