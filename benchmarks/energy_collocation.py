@@ -17,7 +17,8 @@
     equal accuracy: see ``wp``). ``energy-collocation-k5-rule``: the defaults before the potential's defect (k = 5
     for smooth potentials, the rule's defect, refresh at rate 0.3).
 ``python -m benchmarks.energy_collocation stages [--problem B3-8] [--h 1e-2] [--t-end 10]``
-    the energy's spread after the load against the number of silent stages ``k``.
+    the energy's spread after the load against the number of silent stages ``k`` (with the default energy defect:
+    for a non-polynomial potential the potential's own, which keeps the energy whatever ``k``).
 
 Lobatto IIIA-3 runs with the chapter's Newton settings (modified, relative tolerance 1e-8), the
 energy-conserving methods with their own (round-off). One run per configuration (a shared machine:
