@@ -57,11 +57,14 @@ SWEEP_B3 = {"lobatto3": (5e-3, 2.5e-3, 1.25e-3), "energy-collocation": (1e-2, 5e
 
 def method_of(label, model, h):
     """``simulate`` keyword arguments of a method label; ``label:tol=X``: that label with Newton's relative
-    tolerance X (``lobatto3``, ``energy-collocation``)."""
-    if ":tol=" in label:
-        base, tol = label.split(":tol=")
+    tolerance X (``lobatto3``, ``energy-collocation``); ``:contraction=X`` likewise Newton's refresh rate (modified
+    Newton, tolerance 1e-8 unless given)."""
+    if ":" in label:
+        base, *given = label.split(":")
         kw = method_of(base, model, h)
-        kw["newton"] = NewtonOptions(tol=float(tol), jacobian="modified")
+        options = dict(jacobian="modified")
+        options.update((key, float(value)) for key, value in (g.split("=") for g in given))
+        kw["newton"] = NewtonOptions(**options)
         return kw
     if label == "lobatto3":
         return dict(method="lobatto3", h=h, newton=NewtonOptions(tol=1e-8, jacobian="modified"))
