@@ -154,7 +154,7 @@ def equal_accuracy(rows):
 def work_precision(a):
     sweep = SWEEP_B2 if a.problem.startswith("B2") else SWEEP_B3
     if a.methods:
-        sweep = {m: sweep[m.split(":")[0]] for m in a.methods}
+        sweep = {m: sweep.get(m.split(":")[0], sweep["energy-collocation"]) for m in a.methods}   # other labels: EC's
     t_end = a.t_end
     h_ref = a.h_ref or min(sweep.get("energy-collocation", (2.5e-3,))) / 4
     for m in sweep:                                # compile every kernel before the timed runs
@@ -199,9 +199,10 @@ def long_runs(a):
             beam = models.Beam(el, a.elements, 1.0, start=(0.0, 0.0, 0.0), direction=(0.6, 0.8, 0.0),
                                loads=[PointMoment((0.1, 0.05, 0.2), node=0, time=hat(t_load / 2))])
         c0 = time.process_time()
-        res = simulate(beam, (0.0, t_load + a.steps * h), "energy-collocation", h=h, silent_stages=a.silent_stages)
+        res = simulate(beam, (0.0, t_load + a.steps * h), "energy-collocation", h=h, silent_stages=a.silent_stages,
+                       energy_defect=a.energy_defect)
         E = np.array([beam.energy(t, q, v).total for t, q, v in zip(res.t, res.q, res.v) if t >= t_load - 1e-12])
-        print(f"{name:<8}{kw.get('formulation', 'default'):<18}k = {res.options['silent_stages']}  "
+        print(f"{name:<8}{kw.get('formulation', 'default'):<18}k = {res.options['silent_stages']} {res.options['energy_defect']:<9}  "
               f"{'ok' if res.success else 'FAILED'}  free steps {E.size - 1}  "
               f"max|E - E0|/|E| = {np.ptp(E) / np.abs(E).max():.2e}  "
               f"its/step {res.stats['newton_iterations'] / res.stats['steps']:.2f}  "
@@ -253,6 +254,7 @@ def main(argv=None):
     ap.add_argument("--silent-stages", default="auto", type=lambda x: x if x == "auto" else int(x),
                     help="long: k (default 'auto')")
     ap.add_argument("--cases", nargs="+", default=None, help="long: only these (e.g. SQ3D SQ3D-continuum)")
+    ap.add_argument("--energy-defect", default="auto", help="long: energy_defect ('auto', 'rule', 'potential')")
     ap.add_argument("--h-ref", type=float, default=None, help="step of the reference run (default: a quarter of the finest)")
     ap.add_argument("--hs", type=float, nargs="+", default=None, help="wp: only these steps of the sweep")
     ap.add_argument("--ref-method", default="energy-collocation", help="wp: the reference run's method label")
