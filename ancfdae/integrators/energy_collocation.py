@@ -85,7 +85,7 @@ __all__ = ["EnergyCollocation", "SMOOTH_SILENT_STAGES", "CORRECTED_SILENT_STAGES
 #: at k = 5, 9.0e-14 at k = 6).
 SMOOTH_SILENT_STAGES = 5
 #: Silent stages for a non-polynomial potential with ``energy_defect="potential"``: k then sets the accuracy alone
-#: (B3 8 SQ3D, h = 5 ms: eps_T 2.924e-6 at k = 4 and 5, 3.10e-6 at k = 3; docs/energy_momentum.md).
+#: (B3 8 SQ3D, h = 5 ms: eps_T 2.93e-6 at k = 4 and 5, 3.10e-6 at k = 3; docs/energy_momentum.md).
 CORRECTED_SILENT_STAGES = 4
 ITERATION_MATRICES = ("split", "exact")
 ENERGY_CORRECTIONS = ("velocity", "newton")
