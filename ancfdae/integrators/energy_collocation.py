@@ -175,6 +175,7 @@ class EnergyCollocation(NewtonStepper):
         require_potential_split(self.model, self.t, self.q, self.v, self.name)
         self._constrained = "constraints" in capabilities(self.model)
         self._stages = "potential_stages" in capabilities(self.model)
+        self._projection = "potential_projection" in capabilities(self.model)
         if self._constrained:
             self._mscale = mass_scale(self._M)
             if self.lam is None:
@@ -212,31 +213,41 @@ class EnergyCollocation(NewtonStepper):
 
     def _force_terms(self, t0, h):
         """:meth:`_forces` of the step from ``(t0, q, v)`` as a function of ``Y`` alone (see :meth:`_stage_values`)."""
-        values, BPT, BlT = self._stage_values(t0, h), self._co.BP.T.copy(), self._loads.BP.T.copy()
+        values, BlT = self._stage_values(t0, h), self._loads.BP.T.copy()
 
         def forces(Y):
             G, F = values(Y)
-            return G @ BPT - F @ BlT
+            return G - F @ BlT
 
         return forces
 
     def _stage_values(self, t0, h):
-        """``values(Y) -> (G, F)``: ``grad P`` at the ``k`` nodes (n_dof, k) and ``f_nc`` at the 2 Gauss nodes
-        (n_dof, 2) of the step from ``(t0, q, v)``; the nodes' parts that do not depend on ``Y`` formed once per
-        step, the ``k`` gradients in one model call where the model offers it (capability ``"potential_stages"``:
-        one compiled element pass), else one call per node."""
+        """``values(Y) -> (G, F)``: ``sum_l BP[i, l] grad P(sigma_l)`` over the ``k`` nodes (n_dof, 2) and ``f_nc``
+        at the 2 Gauss nodes (n_dof, 2) of the step from ``(t0, q, v)``; the nodes' parts that do not depend on
+        ``Y`` formed once per step. Where the model offers it (capability ``"potential_projection"``) the nodes
+        ``sigma_l = [q0, h v0, Y] @ [1; c_l; Wq[l]]``, their gradients and the projection are one compiled call;
+        else the ``k`` gradients in one model call (``"potential_stages"``) or one call per node, projected here."""
         m, co, ld = self.model, self._co, self._loads
         ts, tl = t0 + co.c * h, t0 + ld.c * h
         base, base_l = self.q[:, None] + np.outer(h * self.v, co.c), self.q[:, None] + np.outer(h * self.v, ld.c)
-        WqT, WlT = co.Wq.T.copy(), ld.Wq.T.copy()
-        stages, gradient, load = self._stages, m.potential_gradient, m.nonconservative_force
+        WqT, WlT, BPT = co.Wq.T.copy(), ld.Wq.T.copy(), co.BP.T.copy()
+        gradient, load, projection, stages = m.potential_gradient, m.nonconservative_force, self._projection, self._stages
+        if projection:
+            Z = np.empty((self.n_dof, 2 + _S))
+            Z[:, 0], Z[:, 1] = self.q, h * self.v
+            A = np.vstack([np.ones(co.k), co.c, WqT])
 
         def values(Y):
-            Q = base + Y @ WqT
-            if stages:
-                G = m.potential_gradient_stages(ts, Q)
+            if projection:
+                Z[:, 2:] = Y
+                G = m.potential_gradient_projection(ts, Z, A, BPT)
             else:
-                G = np.column_stack([gradient(t, Q[:, l], False)[0] for l, t in enumerate(ts)])
+                Q = base + Y @ WqT
+                if stages:
+                    G = m.potential_gradient_stages(ts, Q)
+                else:
+                    G = np.column_stack([gradient(t, Q[:, l], False)[0] for l, t in enumerate(ts)])
+                G = G @ BPT
             Q = base_l + Y @ WlT
             return G, np.column_stack([load(t, Q[:, j], False)[0] for j, t in enumerate(tl)])
 
@@ -286,14 +297,14 @@ class EnergyCollocation(NewtonStepper):
         M, ih2 = self._M, 1.0 / (h * h)
         zn = np.zeros(n)
 
-        values, BPT, BlT = self._stage_values(t0, h), co.BP.T.copy(), self._loads.BP.T.copy()
+        values, eye, BlT = self._stage_values(t0, h), np.eye(_S), self._loads.BP.T.copy()
         mass = (M.data, M.indptr, M.indices)
 
-        def residual(x):      # M Y / h^2 + G BP^T - F BL^T in one compiled call
+        def residual(x):      # M Y / h^2 + G - F BL^T in one compiled call (G projected already)
             Y = x.reshape(n, _S)
             G, F = values(Y)
             R = np.empty((n, _S))
-            stage_residual(Y, np.asarray(G, dtype=float), BPT, np.asarray(F, dtype=float), BlT, *mass, ih2, R)
+            stage_residual(Y, np.asarray(G, dtype=float), eye, np.asarray(F, dtype=float), BlT, *mass, ih2, R)
             return R.ravel()
 
         def jacobian(x):

@@ -270,6 +270,13 @@ class SQCompiled(OnePassKernel):
             hit = geom["_numba_fused"] = (fn, tuple(self._arrays(geom)) + (self.element.dim,))
         return hit
 
+    def fused_projection(self, geom: dict) -> tuple:
+        """``(sq_structural_projection or sq_continuum_projection, args)``: the forces at several configurations,
+        projected (see :meth:`ancfdae.models.Element.fused_projection`; :mod:`.projection_numba`)."""
+        from .projection_numba import sq_continuum_projection, sq_structural_projection
+        fn = sq_structural_projection if self.element.formulation == "structural" else sq_continuum_projection
+        return fn, tuple(self._arrays(geom)) + (self.element.dim,)
+
 
 def compiled_geometry(formulation: str, dim: int, n_strain: int, geom: dict) -> tuple:
     """Contiguous arrays for the compiled kernels, from the NumPy kernel's point groups.
