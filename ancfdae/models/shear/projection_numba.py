@@ -23,7 +23,8 @@ from numba import njit
 
 from ..beam.assembly_numba import gather_configurations, scatter_projection
 from .kernels_numba import _continuum_element, _shape_table, _structural_element
-from .structural3d_numba import NK, NP, NV, N_SCALARS, _point, _scatter
+from .structural3d_force_numba import N_ROWS, point_force
+from .structural3d_numba import NK, NP, NV, _scatter
 from .structural_numba import N_JETS, needs_frame
 
 __all__ = ["sq_structural_projection", "sq_continuum_projection"]
@@ -40,10 +41,8 @@ def _sq3d_structural(Z, q_fixed, gather, vec_slot, A, B, out, N, dN, Dw, ref):
     Qe, fe = np.empty((k, ne)), np.empty((r, ne))
     Sb, col = np.empty((5, nn)), np.empty((5, nn), dtype=np.int64)
     v, g, H = np.empty(NV), np.zeros(NV), np.zeros((NV, NV))
-    gp, Y, K_row = np.empty((r, NV)), np.zeros((NV, ne)), np.zeros((1, ne))
-    JV, JG, JH = np.zeros((N_JETS, 3)), np.zeros((N_JETS, 3, NP)), np.zeros((N_JETS, 3, NP, NP))
-    eps, sig, Jp = np.empty(NK), np.empty(NK), np.zeros((NK, NP))
-    SV, SG, SH = np.zeros(N_SCALARS), np.zeros((N_SCALARS, NP)), np.zeros((N_SCALARS, NP, NP))
+    gp, Y, K_row = np.empty((r, NV)), np.zeros((NV, ne)), np.zeros((1, ne))    # Y, H, K_row: unused at order 1
+    eps, sig, SV, SG = np.empty(NK), np.empty(NK), np.zeros(N_ROWS), np.zeros((N_ROWS, NP))
     for e in range(n_el):
         gather_configurations(Z, q_fixed, gather, e, A, Qe)
         fe[:, :] = 0.0
@@ -58,7 +57,7 @@ def _sq3d_structural(Z, q_fixed, gather, vec_slot, A, B, out, N, dN, Dw, ref):
                         for i in range(nn):
                             x += Sb[b, i] * Qe[l, col[b, i] + c]
                         v[3 * b + c] = x
-                _point(v, Dw[e, p], ref[e, p], JV, JG, JH, SV, SG, SH, eps, sig, Jp, g, H, 1, need_frame)
+                point_force(v, Dw[e, p], ref[e, p], SV, SG, eps, sig, g, need_frame)
                 for s in range(r):
                     w = B[l, s]
                     for i in range(NV):
