@@ -21,6 +21,10 @@ conservative force, interleaved call by call: ``projection`` (``potential_gradie
 compiled call forms, evaluates and weights the ``k`` configurations), ``stages`` (``potential_gradient_stages``:
 the configurations in NumPy, one stacked element pass, the projection in NumPy) and ``per-node`` (one model
 call per configuration); medians and fastest, microseconds.
+
+``python -m benchmarks.hbvm_residual --kernel-orders [--elements 40] [--repeats 2000]`` times the compiled SQ3D
+structural and continuum kernels (``sq_structural``, ``sq_continuum``) at order 0 (energy), 1 (plus force: what
+every residual evaluates) and 2 (plus tangent) on a deformed mesh, interleaved; microseconds per element.
 """
 from __future__ import annotations
 
@@ -143,6 +147,27 @@ def micro(problem, h, at, repeats):
               f"{np.min(ts) * 1e6:8.1f} us")
 
 
+def kernel_orders(n_el, repeats):
+    """Median and fastest time per element of the compiled SQ3D kernels at orders 0, 1, 2 (see the docstring)."""
+    import numpy as np
+    from ancfdae.models.shear.kernels_numba import sq_continuum, sq_structural
+    from .sq_kernels import _model
+    for form, fn in (("structural", sq_structural), ("continuum", sq_continuum)):
+        el, beam, q = _model(form, n_el)
+        arrays = el.kernels._arrays(beam.geom)
+        times = {order: [] for order in (0, 1, 2)}
+        for order in times:
+            fn(q, *arrays, 3, order)
+        for _ in range(repeats):
+            for order, ts in times.items():
+                t0 = time.perf_counter()
+                fn(q, *arrays, 3, order)
+                ts.append(time.perf_counter() - t0)
+        for order, ts in times.items():
+            print(f"SQ3D {form:<11} order {order}: median {np.median(ts) / n_el * 1e6:6.2f} us/element, fastest "
+                  f"{np.min(ts) / n_el * 1e6:6.2f}")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--problem", default="B3-8", choices=tuple(PROBLEMS))
@@ -152,7 +177,11 @@ def main(argv=None):
     ap.add_argument("--micro", action="store_true", help="time one residual per force path (module docstring)")
     ap.add_argument("--at", type=float, default=1.0, help="--micro: the state's time")
     ap.add_argument("--repeats", type=int, default=2000)
+    ap.add_argument("--kernel-orders", action="store_true", help="time the SQ3D kernels per order (docstring)")
+    ap.add_argument("--elements", type=int, default=40, help="--kernel-orders: elements of the mesh")
     a = ap.parse_args(argv)
+    if a.kernel_orders:
+        return kernel_orders(a.elements, a.repeats)
     if a.micro:
         return micro(a.problem, a.h, a.at, a.repeats)
     t_end = a.t_end if a.t_end is not None else (4.0 if a.problem.startswith("B2") else 5.0)

@@ -184,6 +184,8 @@ class EnergyCollocation(NewtonStepper):
     def _bind(self):
         m = self.model
         self._M = sp.csr_matrix(m.mass(self.q))
+        self._M_nz = self._M.copy()       # the residual's mass product over the nonzeros only (same sums)
+        self._M_nz.eliminate_zeros()
         # M alone is factorised for the unconstrained step's acceleration only: a constrained model's M may be
         # singular (a lamina's axis director carries no mass), its accelerations come from the saddle-point
         # (KKT) system, regular on the constraint manifold.
@@ -294,11 +296,11 @@ class EnergyCollocation(NewtonStepper):
         ``split[0]`` is true, else the exact Jacobian."""
         co, n, model = self._co, self.n_dof, self.model
         q0, v0 = self.q, self.v
-        M, ih2 = self._M, 1.0 / (h * h)
+        ih2 = 1.0 / (h * h)
         zn = np.zeros(n)
 
         values, eye, BlT = self._stage_values(t0, h), np.eye(_S), self._loads.BP.T.copy()
-        mass = (M.data, M.indptr, M.indices)
+        mass = (self._M_nz.data, self._M_nz.indptr, self._M_nz.indices)
 
         def residual(x):      # M Y / h^2 + G - F BL^T in one compiled call (G projected already)
             Y = x.reshape(n, _S)
