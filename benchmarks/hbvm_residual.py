@@ -191,7 +191,8 @@ def main(argv=None):
     for label in a.methods:
         r = split(a.problem, label, a.h, t_end)
         print(f"{label:<22}{r['residual']:>9.1f}{r['forces']:>9.1f}{r['kernel']:>9.1f}{r['loads']:>9.1f}"
-              f"{r['rest']:>9.1f}{r['residuals']:>9d}{r['its']:>8.2f}{r['cpu']:>8.2f}" + ("" if r["ok"] else "  FAILED"),
+              f"{r['rest']:>9.1f}{r['residuals']:>9d}{r['its']:>8.2f}{r['cpu']:>8.2f}"
+              + ("" if r["ok"] else "  FAILED"),
               flush=True)
 
 

@@ -233,7 +233,8 @@ class EnergyCollocation(NewtonStepper):
         ts, tl = t0 + co.c * h, t0 + ld.c * h
         base, base_l = self.q[:, None] + np.outer(h * self.v, co.c), self.q[:, None] + np.outer(h * self.v, ld.c)
         WqT, WlT, BPT = co.Wq.T.copy(), ld.Wq.T.copy(), co.BP.T.copy()
-        gradient, load, projection, stages = m.potential_gradient, m.nonconservative_force, self._projection, self._stages
+        gradient, load = m.potential_gradient, m.nonconservative_force
+        projection, stages = self._projection, self._stages
         if projection:
             Z = np.empty((self.n_dof, 2 + _S))
             Z[:, 0], Z[:, 1] = self.q, h * self.v

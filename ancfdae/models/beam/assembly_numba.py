@@ -53,7 +53,7 @@ def scatter(values, slot, out):
 def gather_configurations(Z, q_fixed, gather, e, A, Qe):
     """Element ``e``'s coordinates at the ``k`` configurations ``Z @ A[:, l]`` into ``Qe`` (k, n_edof).
 
-    The projection entry points' gather (:meth:`ancfdae.models.Element.fused_projection`): ``Z`` (n, p)
+    The projection entry points' gather (:meth:`ancfdae.models.beam.stages.StageEvaluator.projection`): ``Z`` (n, p)
     holds the configurations' common vectors (e.g. a polynomial's coefficients), ``A`` (p, k) their
     coefficients per configuration; a fixed coordinate (``gather[e, j] >= n``) keeps its value
     ``q_fixed`` in every configuration.

@@ -96,12 +96,15 @@ class StageEvaluator:
         """``P[:, s] = sum_l B[l, s] dU/dq(Z @ A[:, l])``, shape (n_dof, r), for ``Z`` (n_dof, p), ``A`` (p, k),
         ``B`` (k, r).
 
-        With the element's compiled projection entry point (``fused_projection(geom)`` of its kernel object,
-        offered beside a fused kernel: :mod:`ancfdae.models.shear.projection_numba`,
-        :mod:`ancfdae.models.thin.be2d_projection_numba`) one call forms the configurations per element,
-        evaluates the ``k`` forces and weights them: equal to the reference below to round-off. Else (the
-        NumPy kernel, an element without it) the reference: the configurations ``Z @ A``, their forces in one
-        stacked pass (:meth:`gradients`) and ``G @ B``.
+        With the element's compiled projection entry point one call forms the configurations per element,
+        evaluates the ``k`` forces and weights them: equal to the reference below to round-off. The entry point
+        is the optional method ``fused_projection(geom) -> (fn, args)`` of a compiled kernel object that also
+        offers a fused kernel (:mod:`ancfdae.models.shear.projection_numba`,
+        :mod:`ancfdae.models.thin.be2d_projection_numba`), called as
+        ``fn(Z, q_fixed, gather, vec_slot, A, B, out, *args)`` with ``out`` (n_dof + 1, r) zeroed by ``fn``,
+        its last row the fixed coordinates' share (``gather`` and ``vec_slot`` as for the fused assembly,
+        :mod:`ancfdae.models.beam.assembly_numba`). Else (the NumPy kernel, an element without it) the
+        reference: the configurations ``Z @ A``, their forces in one stacked pass (:meth:`gradients`) and ``G @ B``.
         """
         call = self._cache.get("projection")
         if call is None:

@@ -272,7 +272,7 @@ class SQCompiled(OnePassKernel):
 
     def fused_projection(self, geom: dict) -> tuple:
         """``(sq_structural_projection or sq_continuum_projection, args)``: the forces at several configurations,
-        projected (see :meth:`ancfdae.models.Element.fused_projection`; :mod:`.projection_numba`)."""
+        projected (see :meth:`ancfdae.models.beam.stages.StageEvaluator.projection`; :mod:`.projection_numba`)."""
         from .projection_numba import sq_continuum_projection, sq_structural_projection
         fn = sq_structural_projection if self.element.formulation == "structural" else sq_continuum_projection
         return fn, tuple(self._arrays(geom)) + (self.element.dim,)

@@ -1,6 +1,6 @@
 """Compiled SQ2D/SQ3D internal forces at several configurations, projected, in one call.
 
-The projection entry points of :meth:`ancfdae.models.Element.fused_projection`: for ``k`` configurations
+The projection entry points of :meth:`ancfdae.models.beam.stages.StageEvaluator.projection`: for ``k`` configurations
 ``Q_l = Z @ A[:, l]`` of the free coordinates they return ``P[:, s] = sum_l B[l, s] dU/dq(Q_l)`` (the
 energy-preserving collocation's ``sum_l b_l P_i(c_l) grad U(sigma(c_l))``, chapter Eqs. 104-107 for the
 local variables, the densities of :mod:`.structural_numba`, :mod:`.structural3d_numba` and

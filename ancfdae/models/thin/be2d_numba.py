@@ -300,7 +300,7 @@ class BE2DCompiled(Kernel):
 
     def fused_projection(self, geom: dict) -> tuple:
         """``(be2d_projection, args)``: the forces at several configurations, projected (see
-        :meth:`ancfdae.models.Element.fused_projection`; :mod:`.be2d_projection_numba`)."""
+        :meth:`ancfdae.models.beam.stages.StageEvaluator.projection`; :mod:`.be2d_projection_numba`)."""
         from .be2d_projection_numba import be2d_projection
         return be2d_projection, self._args(geom)
 

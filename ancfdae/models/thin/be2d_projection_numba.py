@@ -1,6 +1,6 @@
 """Compiled BE2D internal forces at several configurations, projected, in one call.
 
-The projection entry point of :meth:`ancfdae.models.Element.fused_projection` for BE2D: for ``k``
+The projection entry point of :meth:`ancfdae.models.beam.stages.StageEvaluator.projection` for BE2D: for ``k``
 configurations ``Q_l = Z @ A[:, l]`` of the free coordinates, ``out[:, s] = sum_l B[l, s] dU/dq(Q_l)``
 (the energy-preserving collocation's projected conservative force; the element force of
 :func:`.be2d_numba._element`, chapter Eqs. 70, 78, 82-88). Per element the configurations' eight
