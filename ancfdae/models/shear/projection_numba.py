@@ -27,7 +27,7 @@ from .structural3d_force_numba import N_ROWS, point_force
 from .structural3d_numba import NK, NP, NV, _scatter
 from .structural_numba import N_JETS, needs_frame
 
-__all__ = ["sq_structural_projection", "sq_continuum_projection"]
+__all__ = ["sq3d_structural_projection", "sq2d_structural_projection", "sq_continuum_projection"]
 
 _OPTS = dict(cache=True, fastmath={"contract"})
 
@@ -94,14 +94,20 @@ def _sq2d_structural(Z, q_fixed, gather, vec_slot, A, B, out, N, dN, Dw, ref):
 
 
 @njit(cache=True)
-def sq_structural_projection(Z, q_fixed, gather, vec_slot, A, B, out, N, dN, Dw, ref, dim):
-    """Structural formulation: ``out[:, s] = sum_l B[l, s] dU/dq(Z @ A[:, l])`` (zeroed first; shape
-    (n_dof + 1, r), last row the fixed coordinates' share). Element arrays as :func:`.kernels_numba.sq_structural`."""
+def sq3d_structural_projection(Z, q_fixed, gather, vec_slot, A, B, out, N, dN, Dw, ref):
+    """SQ3D structural formulation: ``out[:, s] = sum_l B[l, s] dU/dq(Z @ A[:, l])`` (zeroed first; shape
+    (n_dof + 1, r), last row the fixed coordinates' share). Element arrays as :func:`.kernels_numba.sq_structural`.
+    One entry point per dimension: a beam compiles only its own (the 2D one alone took most of the first
+    call's compiling)."""
     out[:, :] = 0.0
-    if dim == 3:
-        _sq3d_structural(Z, q_fixed, gather, vec_slot, A, B, out, N, dN, Dw, ref)
-    else:
-        _sq2d_structural(Z, q_fixed, gather, vec_slot, A, B, out, N, dN, Dw, ref)
+    _sq3d_structural(Z, q_fixed, gather, vec_slot, A, B, out, N, dN, Dw, ref)
+
+
+@njit(cache=True)
+def sq2d_structural_projection(Z, q_fixed, gather, vec_slot, A, B, out, N, dN, Dw, ref):
+    """SQ2D structural formulation: as :func:`sq3d_structural_projection`."""
+    out[:, :] = 0.0
+    _sq2d_structural(Z, q_fixed, gather, vec_slot, A, B, out, N, dN, Dw, ref)
 
 
 @njit(**_OPTS)
@@ -138,7 +144,7 @@ def _continuum(dim, Z, q_fixed, gather, vec_slot, A, B, out, N, dN, wax, blk, co
 @njit(cache=True)
 def sq_continuum_projection(Z, q_fixed, gather, vec_slot, A, B, out, N, dN, wax, blk, coef, cnt, ws, Ds, ref,
                             vi, vj, dim):
-    """Continuum formulation: as :func:`sq_structural_projection`; element arrays as
+    """Continuum formulation: as :func:`sq3d_structural_projection`; element arrays as
     :func:`.kernels_numba.sq_continuum`."""
     out[:, :] = 0.0
     _continuum(dim, Z, q_fixed, gather, vec_slot, A, B, out, N, dN, wax, blk, coef, cnt, ws, Ds, ref, vi, vj)
