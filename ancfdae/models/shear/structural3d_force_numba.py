@@ -74,7 +74,10 @@ def _forms(SV, SG, v, w0, oP, oQ, oD):
     SV[oD] = v[0] * SG[oD, 0] + v[1] * SG[oD, 1] + v[2] * SG[oD, 2]
 
 
-@njit(**_INLINE)
+# One compiled function with an explicit signature, called (not inlined) by the element loops: inlined, its
+# unrolled jet loops made every caller's compile 40 s longer (cold numba cache, B3-8 with Lobatto IIIA-3).
+@njit("float64(float64[::1], float64[:], float64[:], float64[::1], float64[:, ::1], float64[::1], float64[::1], "
+      "float64[::1], boolean)", cache=True, fastmath={"contract"})
 def point_force(v, Dw, ref, SV, SG, eps, sig, g, need_frame):
     """Energy density ``W`` at one point and its gradient in ``v = (a2, a3 | r', a2', a3')`` into ``g`` (15,),
     overwritten; ``eps``, ``sig`` (9,) receive the strains and stresses. ``need_frame`` False: only the
