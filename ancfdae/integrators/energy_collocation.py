@@ -159,6 +159,9 @@ class EnergyCollocation(NewtonStepper):
         self.iteration_matrix = validate.choice("iteration_matrix", iteration_matrix, ITERATION_MATRICES)
         self._co = hbvm_coefficients(k, _S)
         self._loads = hbvm_coefficients(_S, _S)      # the 2-point Gauss rule of the loads
+        co = self._co                                # the rules' matrices as the step uses them, formed once
+        self._WqT, self._WlT, self._BPT = co.Wq.T.copy(), self._loads.Wq.T.copy(), co.BP.T.copy()
+        self._A = np.vstack([np.ones(k), co.c, self._WqT])     # sigma_l = [q0, h v0, Y] @ A[:, l]
         self._pattern = None
 
     def options(self) -> dict:
@@ -231,14 +234,16 @@ class EnergyCollocation(NewtonStepper):
         else the ``k`` gradients in one model call (``"potential_stages"``) or one call per node, projected here."""
         m, co, ld = self.model, self._co, self._loads
         ts, tl = t0 + co.c * h, t0 + ld.c * h
-        base, base_l = self.q[:, None] + np.outer(h * self.v, co.c), self.q[:, None] + np.outer(h * self.v, ld.c)
-        WqT, WlT, BPT = co.Wq.T.copy(), ld.Wq.T.copy(), co.BP.T.copy()
+        base_l = self.q[:, None] + np.outer(h * self.v, ld.c)
+        WqT, WlT, BPT = self._WqT, self._WlT, self._BPT
         gradient, load = m.potential_gradient, m.nonconservative_force
         projection, stages = self._projection, self._stages
         if projection:
             Z = np.empty((self.n_dof, 2 + _S))
             Z[:, 0], Z[:, 1] = self.q, h * self.v
-            A = np.vstack([np.ones(co.k), co.c, WqT])
+            A = self._A
+        else:
+            base = self.q[:, None] + np.outer(h * self.v, co.c)
 
         def values(Y):
             if projection:
