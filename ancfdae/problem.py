@@ -161,6 +161,11 @@ class Model(Protocol):
 #:     with ``"potential"``: ``potential_gradient_stages(ts, Q) -> G`` of shape ``(n_dof, m)``, column ``i``
 #:     ``potential_gradient(ts[i], Q[:, i], False)[0]``: ``m`` configurations in one call (the
 #:     energy-preserving collocation's silent stages).
+#: ``"potential_projection"``
+#:     with ``"potential"``: ``potential_gradient_projection(ts, Z, A, B) -> P`` of shape ``(n_dof, r)``,
+#:     ``P[:, s] = sum_l B[l, s] potential_gradient(ts[l], Z @ A[:, l], False)[0]`` for ``Z`` (n_dof, p), ``A``
+#:     (p, k), ``B`` (k, r): ``k`` configurations that are combinations of a few vectors, their forces
+#:     weighted, in one call (the energy-preserving collocation's projection onto its Legendre basis).
 #: ``"constraints"``
 #:     holonomic constraints ``g(t, q) = 0`` (``n_constraints`` rows); the equations of motion become
 #:     ``r(t, q, v, a) + G^T lam = 0``, ``g = 0`` (``residual`` stays without ``G^T lam``):
@@ -181,6 +186,7 @@ CAPABILITIES: dict[str, tuple[str, ...]] = {
     "step_events": ("event_state", "bind", "step_event"),
     "potential": ("potential", "potential_gradient", "nonconservative_force"),
     "potential_stages": ("potential_gradient_stages",),
+    "potential_projection": ("potential_gradient_projection",),
     "constraints": ("constraints", "constraint_jacobian", "constraint_force_jacobian", "constraint_rates"),
 }
 

@@ -99,6 +99,11 @@ class CountingModel:
         self.n_potential_gradient += len(ts)
         return self.wrapped.potential_gradient_stages(ts, Q)
 
+    def potential_gradient_projection(self, ts, Z, A, B):
+        """The wrapped model's ``potential_gradient_projection``, counted as one gradient per configuration."""
+        self.n_potential_gradient += len(ts)
+        return self.wrapped.potential_gradient_projection(ts, Z, A, B)
+
     # -- forwarded ----------------------------------------------------------------------------
     def __getattr__(self, name):
         # Only for names not defined above (mass, n_dof, event_state, nonconservative_force, ...).

@@ -68,6 +68,8 @@ from ancfdae.integrators._energy_correction import (PotentialDefect, VelocityCor
 from ancfdae.integrators._hbvm_coefficients import hbvm_coefficients
 from ancfdae.integrators._hbvm_constrained import constrained_hbvm_step
 from ancfdae.integrators._hbvm_matrix import ExactMatrix, _SplitMatrix
+from ancfdae.integrators._hbvm_options import (CORRECTED_SILENT_STAGES, ENERGY_CORRECTIONS, ENERGY_DEFECTS,
+                                               SMOOTH_SILENT_STAGES, hbvm_options)
 from ancfdae.integrators._hbvm_numba import stage_residual
 from ancfdae.integrators._newton_records import NewtonOptions
 from ancfdae.integrators._potential_split import require_potential_model, require_potential_split
@@ -79,17 +81,7 @@ from ancfdae.problem import JacobianBlocks, Model, capabilities
 __all__ = ["EnergyCollocation", "SMOOTH_SILENT_STAGES", "CORRECTED_SILENT_STAGES", "ITERATION_MATRICES",
            "ENERGY_CORRECTIONS", "ENERGY_DEFECTS", "CORRECTED_NEWTON"]
 
-#: Silent stages for a potential that is not a polynomial (chosen by measurement, see docs/energy_momentum.md:
-#: one element, 1000 steps of 10 ms, energy drift SQ3D structural 3.6e-11 / 6.6e-14 / 3.8e-14 at k = 4 / 5 / 6,
-#: SQ2D structural 2.0e-13 / 3.1e-14 / 3.0e-14, BE2D 8.4e-14 / 3.9e-14 / 4.3e-14; B3 8 SQ3D, h = 5 ms: 8.5e-14
-#: at k = 5, 9.0e-14 at k = 6).
-SMOOTH_SILENT_STAGES = 5
-#: Silent stages for a non-polynomial potential with ``energy_defect="potential"``: k then sets the accuracy alone
-#: (B3 8 SQ3D, h = 5 ms: eps_T 2.93e-6 at k = 4 and 5, 3.10e-6 at k = 3; docs/energy_momentum.md).
-CORRECTED_SILENT_STAGES = 4
 ITERATION_MATRICES = ("split", "exact")
-ENERGY_CORRECTIONS = ("velocity", "newton")
-ENERGY_DEFECTS = ("rule", "potential")
 #: Newton of ``energy_correction="velocity"``: the chapter's relative tolerance, as Lobatto IIIA-3; refresh at rate 0.2
 #: (B3 8 SQ3D, h = 5 ms: 7.14 against 8.08 it/step at 0.3, 0.70 against 0.39 refreshes; docs/energy_momentum.md).
 CORRECTED_NEWTON = NewtonOptions(tol=1e-8, contraction=0.2)
@@ -143,41 +135,20 @@ class EnergyCollocation(NewtonStepper):
             raise ValueError("`model` constraints must be at most quadratic in q (constraint_degree 1 or 2) for "
                              f"method {self.name!r}, whose 3-point exactness of d g(sigma)/dc keeps the joints "
                              f"workless; got constraint_degree={getattr(model, 'constraint_degree', None)!r}.")
-        correction = validate.choice("energy_correction", energy_correction, ("auto",) + ENERGY_CORRECTIONS)
-        constrained = "constraints" in capabilities(model)
-        if correction == "auto":
-            correction = "newton" if constrained else "velocity"
-        elif correction == "velocity" and constrained:
-            raise ValueError("`energy_correction` 'velocity' cannot keep the constraints (it changes v1 alone); "
-                             "use 'newton' or 'auto' for a model with the 'constraints' capability.")
+        correction, defect, k = hbvm_options(model, silent_stages, energy_correction, energy_defect)
         if newton is None:
             newton = CORRECTED_NEWTON if correction == "velocity" else DEFAULT_NEWTON
         super().__init__(model, h, newton=newton)
-        self.energy_correction = correction
+        self.energy_correction, self.energy_defect, self.silent_stages = correction, defect, k
         if correction == "velocity":      # Newton stops at a tolerance, as Lobatto IIIA-3: its floor and update
             self.FLOOR_ROUNDOFF, self.FLOOR_UPDATE = NewtonStepper.FLOOR_ROUNDOFF, NewtonStepper.FLOOR_UPDATE
-        defect = validate.choice("energy_defect", energy_defect, ("auto",) + ENERGY_DEFECTS)
-        if defect == "potential" and correction != "velocity":
-            raise ValueError("`energy_defect` 'potential' is removed by the velocity correction only; got "
-                             f"energy_correction={correction!r}.")
-        degree = getattr(model, "potential_degree", None)
-        if isinstance(silent_stages, str) and silent_stages == "auto":
-            corrected = correction == "velocity" and defect != "rule"
-            k = max(_S, int(degree)) if degree is not None else (
-                CORRECTED_SILENT_STAGES if corrected else SMOOTH_SILENT_STAGES)
-        elif isinstance(silent_stages, (int, np.integer)) and not isinstance(silent_stages, bool) \
-                and silent_stages >= _S:
-            k = int(silent_stages)
-        else:
-            raise ValueError(f"`silent_stages` must be 'auto' or an integer >= {_S}, got {silent_stages!r}.")
-        self.silent_stages = k
-        if defect == "auto":
-            defect = "rule" if correction != "velocity" or (degree is not None and int(degree) <= k) else "potential"
-        self.energy_defect = defect
         self.iteration_matrix = validate.choice("iteration_matrix", iteration_matrix, ITERATION_MATRICES)
         self._co = hbvm_coefficients(k, _S)
         self._loads = hbvm_coefficients(_S, _S)      # the 2-point Gauss rule of the loads
         self._exact_matrix = ExactMatrix(self._co, self._loads)
+        co = self._co                                # the rules' matrices as the step uses them, formed once
+        self._WqT, self._WlT, self._BPT = co.Wq.T.copy(), self._loads.Wq.T.copy(), co.BP.T.copy()
+        self._A = np.vstack([np.ones(k), co.c, self._WqT])     # sigma_l = [q0, h v0, Y] @ A[:, l]
 
     def options(self) -> dict:
         """The options as a JSON-able dict: ``h``, the Newton options, ``silent_stages``, ``iteration_matrix``."""
@@ -193,6 +164,7 @@ class EnergyCollocation(NewtonStepper):
         require_potential_split(self.model, self.t, self.q, self.v, self.name)
         self._constrained = "constraints" in capabilities(self.model)
         self._stages = "potential_stages" in capabilities(self.model)
+        self._projection = "potential_projection" in capabilities(self.model)
         if self._constrained:
             self._mscale = mass_scale(self._M)
             if self.lam is None:
@@ -201,6 +173,8 @@ class EnergyCollocation(NewtonStepper):
     def _bind(self):
         m = self.model
         self._M = sp.csr_matrix(m.mass(self.q))
+        self._M_nz = self._M.copy()       # the residual's mass product over the nonzeros only (same sums)
+        self._M_nz.eliminate_zeros()
         # M alone is factorised for the unconstrained step's acceleration only: a constrained model's M may be
         # singular (a lamina's axis director carries no mass), its accelerations come from the saddle-point
         # (KKT) system, regular on the constraint manifold.
@@ -232,31 +206,44 @@ class EnergyCollocation(NewtonStepper):
 
     def _force_terms(self, t0, h):
         """:meth:`_forces` of the step from ``(t0, q, v)`` as a function of ``Y`` alone (see :meth:`_stage_values`)."""
-        values, BPT, BlT = self._stage_values(t0, h), self._co.BP.T.copy(), self._loads.BP.T.copy()
+        values, BlT = self._stage_values(t0, h), self._loads.BP.T.copy()
 
         def forces(Y):
             G, F = values(Y)
-            return G @ BPT - F @ BlT
+            return G - F @ BlT
 
         return forces
 
     def _stage_values(self, t0, h):
-        """``values(Y) -> (G, F)``: ``grad P`` at the ``k`` nodes (n_dof, k) and ``f_nc`` at the 2 Gauss nodes
-        (n_dof, 2) of the step from ``(t0, q, v)``; the nodes' parts that do not depend on ``Y`` formed once per
-        step, the ``k`` gradients in one model call where the model offers it (capability ``"potential_stages"``:
-        one compiled element pass), else one call per node."""
+        """``values(Y) -> (G, F)``: ``sum_l BP[i, l] grad P(sigma_l)`` over the ``k`` nodes (n_dof, 2) and ``f_nc``
+        at the 2 Gauss nodes (n_dof, 2) of the step from ``(t0, q, v)``; the nodes' parts that do not depend on
+        ``Y`` formed once per step. Where the model offers it (capability ``"potential_projection"``) the nodes
+        ``sigma_l = [q0, h v0, Y] @ [1; c_l; Wq[l]]``, their gradients and the projection are one compiled call;
+        else the ``k`` gradients in one model call (``"potential_stages"``) or one call per node, projected here."""
         m, co, ld = self.model, self._co, self._loads
         ts, tl = t0 + co.c * h, t0 + ld.c * h
-        base, base_l = self.q[:, None] + np.outer(h * self.v, co.c), self.q[:, None] + np.outer(h * self.v, ld.c)
-        WqT, WlT = co.Wq.T.copy(), ld.Wq.T.copy()
-        stages, gradient, load = self._stages, m.potential_gradient, m.nonconservative_force
+        base_l = self.q[:, None] + np.outer(h * self.v, ld.c)
+        WqT, WlT, BPT = self._WqT, self._WlT, self._BPT
+        gradient, load = m.potential_gradient, m.nonconservative_force
+        projection, stages = self._projection, self._stages
+        if projection:
+            Z = np.empty((self.n_dof, 2 + _S))
+            Z[:, 0], Z[:, 1] = self.q, h * self.v
+            A = self._A
+        else:
+            base = self.q[:, None] + np.outer(h * self.v, co.c)
 
         def values(Y):
-            Q = base + Y @ WqT
-            if stages:
-                G = m.potential_gradient_stages(ts, Q)
+            if projection:
+                Z[:, 2:] = Y
+                G = m.potential_gradient_projection(ts, Z, A, BPT)
             else:
-                G = np.column_stack([gradient(t, Q[:, l], False)[0] for l, t in enumerate(ts)])
+                Q = base + Y @ WqT
+                if stages:
+                    G = m.potential_gradient_stages(ts, Q)
+                else:
+                    G = np.column_stack([gradient(t, Q[:, l], False)[0] for l, t in enumerate(ts)])
+                G = G @ BPT
             Q = base_l + Y @ WlT
             return G, np.column_stack([load(t, Q[:, j], False)[0] for j, t in enumerate(tl)])
 
@@ -284,18 +271,18 @@ class EnergyCollocation(NewtonStepper):
         ``split[0]`` is true, else the exact Jacobian."""
         co, n, model = self._co, self.n_dof, self.model
         q0, v0 = self.q, self.v
-        M, ih2 = self._M, 1.0 / (h * h)
+        ih2 = 1.0 / (h * h)
         zn = np.zeros(n)
 
-        values, BPT, BlT = self._stage_values(t0, h), co.BP.T.copy(), self._loads.BP.T.copy()
-        mass = (M.data, M.indptr, M.indices)
+        values, eye, BlT = self._stage_values(t0, h), np.eye(_S), self._loads.BP.T.copy()
+        mass = (self._M_nz.data, self._M_nz.indptr, self._M_nz.indices)
 
-        def residual(x):      # M Y / h^2 + G BP^T - F BL^T in one compiled call
+        def residual(x):      # M Y / h^2 + G - F BL^T in one compiled call (G projected already)
             Y = x.reshape(n, _S)
             G, F = values(Y)
             self._last_loads = (x, F)
             R = np.empty((n, _S))
-            stage_residual(Y, np.asarray(G, dtype=float), BPT, np.asarray(F, dtype=float), BlT, *mass, ih2, R)
+            stage_residual(Y, np.asarray(G, dtype=float), eye, np.asarray(F, dtype=float), BlT, *mass, ih2, R)
             return R.ravel()
 
         def jacobian(x):

@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["gather_elements", "scatter"]
+__all__ = ["gather_elements", "scatter", "gather_configurations", "scatter_projection"]
 
 
 @njit(cache=True)
@@ -47,3 +47,40 @@ def scatter(values, slot, out):
     flat = values.reshape(-1)
     for k in range(slot.size):
         out[slot[k]] += flat[k]
+
+
+@njit(cache=True, inline="always")
+def gather_configurations(Z, q_fixed, gather, e, A, Qe):
+    """Element ``e``'s coordinates at the ``k`` configurations ``Z @ A[:, l]`` into ``Qe`` (k, n_edof).
+
+    The projection entry points' gather (:meth:`ancfdae.models.beam.stages.StageEvaluator.projection`): ``Z`` (n, p)
+    holds the configurations' common vectors (e.g. a polynomial's coefficients), ``A`` (p, k) their
+    coefficients per configuration; a fixed coordinate (``gather[e, j] >= n``) keeps its value
+    ``q_fixed`` in every configuration.
+    """
+    n, p = Z.shape
+    k, nd = Qe.shape
+    for j in range(nd):
+        g = gather[e, j]
+        if g < n:
+            for l in range(k):
+                x = 0.0
+                for m in range(p):
+                    x += Z[g, m] * A[m, l]
+                Qe[l, j] = x
+        else:
+            for l in range(k):
+                Qe[l, j] = q_fixed[g - n]
+
+
+@njit(cache=True, inline="always")
+def scatter_projection(fe, e, vec_slot, out):
+    """``out[vec_slot[e n_edof + j], s] += fe[s, j]``: element ``e``'s projected forces (r, n_edof) into
+    ``out`` (n + 1, r), whose last row collects the fixed coordinates' share."""
+    r, nd = fe.shape
+    b = nd * e
+    for j in range(nd):
+        row = vec_slot[b + j]
+        for s in range(r):
+            out[row, s] += fe[s, j]
+

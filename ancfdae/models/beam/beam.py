@@ -33,7 +33,7 @@ from .compiled import compiled_residual
 from .loads import LoadSet, load_sequence
 from .mass_forms import MassForms
 from .potential import symmetry_generators
-from .stages import StageEvaluator, potential_gradient_stages
+from .stages import StageEvaluator, potential_gradient_projection, potential_gradient_stages
 
 __all__ = ["Beam"]
 
@@ -195,7 +195,7 @@ class Beam(MassForms):
         """The optional capabilities this beam offers (see :func:`ancfdae.problem.capabilities`)."""
         caps = {"residual_jacobian", "residual_stages"}
         if self.mass_is_constant or callable(getattr(self.element, "mass_bilinear", None)):
-            caps |= {"potential", "potential_stages"}   # d/dt(M v) - dT/dq + dP/dq - f_nc; constant M or its forms
+            caps |= {"potential", "potential_stages", "potential_projection"}   # d/dt(M v) - dT/dq + dP/dq - f_nc
         if not self.mass_is_constant:
             caps |= {"variable_mass"} | ({"mass_forms"} if "potential" in caps else set())
         if self.element.event_state(self.geom):
@@ -367,7 +367,7 @@ class Beam(MassForms):
         return self._stages.residuals(Q, A, F_ext, float(self.load_factor))
 
     compiled_residual = compiled_residual   # the residual as compiled pieces, or None (:mod:`.compiled`)
-    potential_gradient_stages = potential_gradient_stages   # k configurations in one pass (:mod:`.stages`)
+    potential_gradient_stages, potential_gradient_projection = potential_gradient_stages, potential_gradient_projection
 
     # -- the potential capability (ancfdae.problem.PotentialModel) ---------
     @property

@@ -1,6 +1,8 @@
 """The stage evaluator of a :class:`~ancfdae.models.Beam`: the residuals of several stages from one element
 pass over the stages' elements stacked (the optional ``residual_stages`` Model method, which Lobatto IIIA
-uses); it halves the per-call overhead of small meshes."""
+uses; it halves the per-call overhead of small meshes), and the conservative force at several
+configurations, alone or projected (``potential_gradient_stages``, ``potential_gradient_projection``: the
+energy-preserving collocation's silent stages)."""
 from __future__ import annotations
 
 import functools
@@ -10,7 +12,7 @@ import numpy as np
 from ..._validate import check_shape
 from .assembly import Assembler
 
-__all__ = ["StageEvaluator", "potential_gradient_stages"]
+__all__ = ["StageEvaluator", "potential_gradient_stages", "potential_gradient_projection"]
 
 
 @functools.cache
@@ -50,8 +52,12 @@ class StageEvaluator:
         self._q_ref_elements, self._lengths = q_ref_elements, lengths
         self._gather, self._q_fixed = gather, q_fixed
         self._asm = assembler
-        self._mass_data = mass_data
         self._mass_csr = assembler.csr(mass_data)
+        # The compiled finish multiplies by the mass' nonzeros only: the assembler's pattern is the stiffness',
+        # mostly zeros for the mass (B3, 16 SQ3D: 1161 of 10449 entries). The same sums (a zero adds nothing).
+        nz = self._mass_csr.copy()
+        nz.eliminate_zeros()
+        self._mass_nz = (nz.data, nz.indptr, nz.indices)
         self._no_k = np.empty(1)
         self._cache = {}
 
@@ -86,6 +92,42 @@ class StageEvaluator:
            F.reshape(-1), self._no_k, *args)
         return F[:, :n].T
 
+    def projection(self, Z: np.ndarray, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        """``P[:, s] = sum_l B[l, s] dU/dq(Z @ A[:, l])``, shape (n_dof, r), for ``Z`` (n_dof, p), ``A`` (p, k),
+        ``B`` (k, r).
+
+        With the element's compiled projection entry point one call forms the configurations per element,
+        evaluates the ``k`` forces and weights them: equal to the reference below to round-off. The entry point
+        is the optional method ``fused_projection(geom) -> (fn, args)`` of a compiled kernel object that also
+        offers a fused kernel (:mod:`ancfdae.models.shear.projection_numba`,
+        :mod:`ancfdae.models.thin.be2d_projection_numba`), called as
+        ``fn(Z, q_fixed, gather, vec_slot, A, B, out, *args)`` with ``out`` (n_dof + 1, r) zeroed by ``fn``,
+        its last row the fixed coordinates' share (``gather`` and ``vec_slot`` as for the fused assembly,
+        :mod:`ancfdae.models.beam.assembly_numba`). Else (the NumPy kernel, an element without it) the
+        reference: the configurations ``Z @ A``, their forces in one stacked pass (:meth:`gradients`) and ``G @ B``.
+        """
+        call = self._cache.get("projection")
+        if call is None:
+            call = self._cache["projection"] = self._projection_call()
+        if not call:
+            return self.gradients(Z @ A) @ B
+        fn, head, args = call
+        out = np.empty((Z.shape[0] + 1, B.shape[1]))
+        fn(np.ascontiguousarray(Z, dtype=float), *head, np.ascontiguousarray(A, dtype=float),
+           np.ascontiguousarray(B, dtype=float), out, *args)
+        return out[:-1]
+
+    def _projection_call(self):
+        """``(fn, (q_fixed, gather, vec_slot), args)`` of the element's projection entry point, or ``()``: only
+        beside a fused kernel (an element subclass that declines the fused path declines this one too)."""
+        geom, gather, _, q_fixed = self._stacked(1)
+        entry = getattr(getattr(self.element, "kernels", None), "fused_projection", None) \
+            if self.element.fused_kernel(geom) is not None else None
+        if entry is None:
+            return ()
+        fn, args = entry(geom)
+        return fn, (q_fixed, gather, self._asm._vec_all), tuple(args)
+
     def residuals(self, Q: np.ndarray, A: np.ndarray, F_ext: np.ndarray, load_factor: float) -> np.ndarray:
         """``R[:, i] = f(Q[:, i]) + M A[:, i] - load_factor F_ext[:, i]``, shape (n_dof, m)."""
         n, m = Q.shape
@@ -106,7 +148,7 @@ class StageEvaluator:
         fn(np.ascontiguousarray(Q, dtype=float).reshape(-1), q_fixed_m, gather, idx, self._asm._slot_all, False,
            F.reshape(-1), self._no_k, *args)
         R = np.empty((n, m))
-        _finish_stages()(F, self._mass_data, self._asm.indptr, self._asm.indices, np.ascontiguousarray(A, dtype=float),
+        _finish_stages()(F, *self._mass_nz, np.ascontiguousarray(A, dtype=float),
                          float(load_factor), F_ext, R)
         return R
 
@@ -121,3 +163,23 @@ def potential_gradient_stages(beam: "ancfdae.models.Beam", ts: np.ndarray, Q: np
         check_shape("Q", Q, (beam.n_dof, m), f"(n_dof, number of configurations) = ({beam.n_dof}, {m})")
     G = beam._stages.gradients(Q)
     return G - beam.load_factor * beam._load_set.gravity[:, None]
+
+
+def potential_gradient_projection(beam: "ancfdae.models.Beam", ts: np.ndarray, Z: np.ndarray, A: np.ndarray,
+                                  B: np.ndarray) -> np.ndarray:
+    """``P[:, s] = sum_l B[l, s] beam.potential_gradient(ts[l], Z @ A[:, l], False)[0]``, shape (n_dof, r): the
+    conservative force at ``k`` configurations ``Z @ A[:, l]`` (``Z`` (n_dof, p), ``A`` (p, k)) weighted by
+    ``B`` (k, r) in one compiled call where the element offers it (the ``"potential_projection"`` capability
+    of :mod:`ancfdae.problem`; :meth:`StageEvaluator.projection`)."""
+    k, zs, bs = np.size(ts), np.shape(Z), np.shape(B)
+    if np.ndim(ts) != 1 or len(zs) != 2 or zs[0] != beam.n_dof or np.shape(A) != (zs[1], k) or len(bs) != 2 \
+            or bs[0] != k:
+        check_shape("ts", ts, (k,), "one time per configuration")
+        check_shape("Z", Z, (beam.n_dof, np.shape(A)[0] if np.ndim(A) == 2 else 1), "(n_dof, p) with A (p, k)")
+        check_shape("A", A, (zs[1] if len(zs) == 2 else 1, k), "(columns of Z, number of configurations)")
+        check_shape("B", B, (k, bs[-1] if bs else 1), "(number of configurations, r)")
+    P = beam._stages.projection(Z, A, B)
+    gravity = beam._load_set.gravity
+    if beam.load_factor != 0.0 and gravity.any():     # sum_l B[l, s] (-lambda f_gravity)
+        P -= (beam.load_factor * gravity)[:, None] * np.sum(B, axis=0)[None, :]
+    return P

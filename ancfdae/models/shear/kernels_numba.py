@@ -270,6 +270,16 @@ class SQCompiled(OnePassKernel):
             hit = geom["_numba_fused"] = (fn, tuple(self._arrays(geom)) + (self.element.dim,))
         return hit
 
+    def fused_projection(self, geom: dict) -> tuple:
+        """``(fn, args)``: the forces at several configurations, projected (``sq3d_structural_projection``,
+        ``sq2d_structural_projection`` or ``sq_continuum_projection`` of :mod:`.projection_numba`; see
+        :meth:`ancfdae.models.beam.stages.StageEvaluator.projection`)."""
+        from . import projection_numba as pn
+        if self.element.formulation == "structural":     # one entry point per dimension (compiled on first use)
+            return (pn.sq3d_structural_projection if self.element.dim == 3 else pn.sq2d_structural_projection,
+                    tuple(self._arrays(geom)))
+        return pn.sq_continuum_projection, tuple(self._arrays(geom)) + (self.element.dim,)
+
 
 def compiled_geometry(formulation: str, dim: int, n_strain: int, geom: dict) -> tuple:
     """Contiguous arrays for the compiled kernels, from the NumPy kernel's point groups.

@@ -25,6 +25,7 @@ from numba import njit
 
 from ..jets import vector_numba as jet
 from .structural_numba import N_JETS, SQUARES_3D, TERMS_3D, frame3d, needs_frame
+from .structural3d_force_numba import N_ROWS, point_force
 
 __all__ = ["sq3d_structural_elements"]
 
@@ -312,6 +313,7 @@ def sq3d_structural_elements(q, N, dN, Dw, ref, order, Sb, col, W, f, K):
     JV, JG, JH = np.zeros((N_JETS, 3)), np.zeros((N_JETS, 3, NP)), np.zeros((N_JETS, 3, NP, NP))
     eps, sig, Jp = np.empty(NK), np.empty(NK), np.zeros((NK, NP))
     SV, SG, SH = np.zeros(N_SCALARS), np.zeros((N_SCALARS, NP)), np.zeros((N_SCALARS, NP, NP))
+    FV, FG = np.zeros(N_ROWS), np.zeros((N_ROWS, NP))
     for e in range(n_el):
         qe = q[e]
         f_row = f[e]
@@ -330,7 +332,10 @@ def sq3d_structural_elements(q, N, dN, Dw, ref, order, Sb, col, W, f, K):
                         x += Sb[b, i] * qe[col[b, i] + c]
                     v[3 * b + c] = x
             need_frame = needs_frame(3, Dw[e, p])
-            w += _point(v, Dw[e, p], ref[e, p], JV, JG, JH, SV, SG, SH, eps, sig, Jp, g, H, order, need_frame)
+            if order == 1:     # the force alone: scalar chain, no vector jets (:mod:`.structural3d_force_numba`)
+                w += point_force(v, Dw[e, p], ref[e, p], FV, FG, eps, sig, g, need_frame)
+            else:
+                w += _point(v, Dw[e, p], ref[e, p], JV, JG, JH, SV, SG, SH, eps, sig, Jp, g, H, order, need_frame)
             if order >= 1:
                 _scatter(g, H, Sb, col, 5 if need_frame else 2, Y, f_row, K_row, order)
         W[e] = w

@@ -298,6 +298,12 @@ class BE2DCompiled(Kernel):
         """``(be2d_fused, args)``: the fused assembly entry point (see :meth:`ancfdae.models.Element.fused_kernel`)."""
         return be2d_fused, self._args(geom)
 
+    def fused_projection(self, geom: dict) -> tuple:
+        """``(be2d_projection, args)``: the forces at several configurations, projected (see
+        :meth:`ancfdae.models.beam.stages.StageEvaluator.projection`; :mod:`.be2d_projection_numba`)."""
+        from .be2d_projection_numba import be2d_projection
+        return be2d_projection, self._args(geom)
+
     def alpha_iterations(self, geom: dict) -> tuple:
         """``(be2d_alpha_iterations, args)``: compiled Newton iterations (:mod:`ancfdae.models.beam.iteration_numba`)."""
         return be2d_alpha_iterations, self._args(geom)

@@ -59,14 +59,16 @@ def test_bad_shapes_name_the_argument():
 
 
 class _PerNode:
-    """The beam without the ``"potential_stages"`` capability: the collocation calls it once per node."""
+    """The beam without the ``"potential_projection"`` capability and, unless ``stages``, without
+    ``"potential_stages"``: the collocation calls it once per node (or once per step's stacked nodes)."""
 
-    def __init__(self, beam):
+    def __init__(self, beam, stages=False):
         self.beam = beam
-        self.capabilities = capabilities(beam) - {"potential_stages"}
+        self.capabilities = capabilities(beam) - {"potential_projection"} - (set() if stages else {"potential_stages"})
+        self._hidden = {"potential_gradient_projection"} | (set() if stages else {"potential_gradient_stages"})
 
     def __getattr__(self, name):
-        if name == "potential_gradient_stages":
+        if name in self._hidden:
             raise AttributeError(name)
         return getattr(self.beam, name)
 
@@ -74,7 +76,8 @@ class _PerNode:
 @pytest.mark.parametrize("name", ["BE2D", "SQ3D"])
 def test_collocation_step_equals_its_per_node_twin(name):
     beam = b2(name, 2) if name == "BE2D" else b3(name, 2)
-    runs = [simulate(m, (0.0, 0.2), "energy-collocation", h=2e-2) for m in (beam, _PerNode(beam))]
+    runs = [simulate(m, (0.0, 0.2), "energy-collocation", h=2e-2)
+            for m in (_PerNode(beam, stages=True), _PerNode(beam))]
     assert all(r.success for r in runs)
     scale = np.abs(runs[1].q).max()
     assert np.abs(runs[0].q - runs[1].q).max() <= 1e-13 * scale

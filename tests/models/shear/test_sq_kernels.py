@@ -59,6 +59,8 @@ def test_numba_kernel_with_one_rule_for_all_terms(steel, cls):
     for q in qs:
         (W0, f0, K0), (W1, f1, K1) = _both(el, beam.geom, q)
         assert rel_err(W1, W0) < 1e-12 and rel_err(f1, f0) < 1e-12 and rel_err(K1, K0) < 1e-12
+        (_, f2, _), (_, f3, _) = _both(el, beam.geom, q, tangent=False)     # the force-only pass (SQ3D: its own)
+        assert rel_err(f3, f0) < 1e-12
 
 
 @pytest.mark.parametrize("nodes", [3, 2])
@@ -71,6 +73,8 @@ def test_sq3d_cross_section_points_off_the_nodes(steel, nodes):
     for q in qs:
         (W0, f0, K0), (W1, f1, K1) = _both(el, beam.geom, q)
         assert rel_err(W1, W0) < 1e-12 and rel_err(f1, f0) < 1e-12 and rel_err(K1, K0) < 1e-12
+        (_, f2, _), (_, f3, _) = _both(el, beam.geom, q, tangent=False)     # the force-only pass
+        assert rel_err(f3, f0) < 1e-12
 
 
 @pytest.mark.parametrize("cls", [SQ2D, SQ3D])
