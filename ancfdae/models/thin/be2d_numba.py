@@ -22,11 +22,10 @@ from ...integrators._alpha_steps_numba import alpha_steps
 from ..beam.static_numba import static_newton
 from ...integrators._index3_steps_numba import index3_steps, system_multipliers
 from ..element import Kernel
+from .be2d_energy_numba import CONTINUUM, STRUCTURAL, be2d_energies, be2d_energy_fused
 
 __all__ = ["BE2DCompiled", "be2d_forces", "be2d_fused", "be2d_alpha_iterations", "be2d_alpha_steps",
            "be2d_static_newton", "be2d_index3_steps", "be2d_multipliers", "STRUCTURAL", "CONTINUUM"]
-
-STRUCTURAL, CONTINUUM = 0, 1
 
 
 @njit(cache=True, inline="always", fastmath={"contract"})
@@ -317,3 +316,12 @@ class BE2DCompiled(Kernel):
     def multipliers(self, geom: dict) -> tuple:
         """``(be2d_multipliers, args)``: a System's reactions at an output time (:mod:`ancfdae.system_compiled`)."""
         return be2d_multipliers, self._args(geom)
+
+    def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
+        """As :meth:`.be2d.BE2DReference.strain_energy`, compiled (:mod:`.be2d_energy_numba`)."""
+        return be2d_energies(np.ascontiguousarray(q, dtype=float), *self._args(geom))
+
+    def fused_energy(self, geom: dict) -> tuple:
+        """``(be2d_energy_fused, args)``: the beam's strain energy read through its gather (the optional kernel
+        method of :func:`ancfdae.models.beam.potential.beam_potential`)."""
+        return be2d_energy_fused, self._args(geom)
