@@ -6,7 +6,8 @@ The same force and exact tangent as the NumPy reference :class:`.be2d.BE2DRefere
 quadrature points: on small meshes it removes the per-call overhead of some
 fifty NumPy operations on arrays of a few hundred entries. The tests compare
 the two on random deformed states. :class:`BE2DCompiled` is the kernel object;
-it also offers the fused assembly entry point :func:`be2d_fused`.
+it also offers the fused assembly entry point :func:`be2d_fused` and the strain
+energy of :mod:`.be2d_energy_numba`.
 
 Importing this module compiles (or loads) numba code; :mod:`.be2d` imports it
 only when the compiled kernel is selected.
