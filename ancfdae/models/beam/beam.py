@@ -32,7 +32,7 @@ from .attach import beam_attachment
 from .compiled import compiled_residual
 from .loads import LoadSet, load_sequence
 from .mass_forms import MassForms
-from .potential import symmetry_generators
+from .potential import beam_potential, symmetry_generators
 from .stages import StageEvaluator, potential_gradient_projection, potential_gradient_stages
 
 __all__ = ["Beam"]
@@ -375,10 +375,7 @@ class Beam(MassForms):
         """Polynomial degree of ``P`` in the coordinates, or None (from the element's ``energy_degree``)."""
         return getattr(self.element, "energy_degree", None)
 
-    def potential(self, t: float, q: np.ndarray) -> float:
-        """``U(q) + V(q)``, with the gravity potential zero in the reference configuration."""
-        U = float(np.sum(self.element.strain_energy(self.geom, self._element_q(q))))
-        return U - self.load_factor * float(self._load_set.gravity @ (q - self.q_ref[self.free]))
+    potential = beam_potential   # U(q) + V(q), U compiled where the element offers it (:mod:`.potential`)
 
     def potential_gradient(self, t: float, q: np.ndarray,
                            tangent: bool = True) -> tuple[np.ndarray, sp.csr_matrix | None]:

@@ -3,14 +3,37 @@
 
 Energy-momentum integrators need the conservative part of the beam's forces on its own (the beam's
 ``potential``, ``potential_gradient`` and ``nonconservative_force``) and the rigid motions that leave the
-strain energy unchanged, which :func:`symmetry_generators` gives.
+strain energy unchanged, which :func:`symmetry_generators` gives; :func:`beam_potential` is the beam's
+``potential``.
 """
 from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["symmetry_generators"]
+from ..element import Element
+
+__all__ = ["symmetry_generators", "beam_potential"]
+
+
+def beam_potential(beam: "ancfdae.models.Beam", t: float, q: np.ndarray) -> float:
+    """``U(q) + V(q)``, with the gravity potential zero in the reference configuration (the beam's ``potential``).
+
+    ``U`` in one compiled call where the element's kernel object offers the optional method
+    ``fused_energy(geom) -> (fn, args)``: ``U = fn(q, q_fixed, gather, *args)``, the elements' energies summed
+    with their coordinates read through the beam's gather (:mod:`ancfdae.models.thin.be2d_energy_numba`;
+    energy-collocation's energy balance calls this once per step; cost of both paths:
+    ``python -m benchmarks.be2d_potential``). Else, as for an element subclass with its own ``strain_energy``,
+    the sum of ``element.strain_energy``; both equal to round-off (``tests/models/thin/test_be2d_energy.py``).
+    """
+    el = beam.element
+    fused = getattr(getattr(el, "kernels", None), "fused_energy", None)
+    if fused is None or type(el).strain_energy is not Element.strain_energy:
+        U = float(np.sum(el.strain_energy(beam.geom, beam._element_q(q))))
+    else:
+        fn, args = fused(beam.geom)
+        U = fn(np.ascontiguousarray(q, dtype=float), beam._q_fixed, beam._gather, *args)
+    return U - beam.load_factor * float(beam._load_set.gravity @ (q - beam.q_ref[beam.free]))
 
 
 def symmetry_generators(dim: int, node_dof: int, n_nodes: int, fixed: np.ndarray) -> tuple[np.ndarray, list]:

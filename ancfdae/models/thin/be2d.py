@@ -156,6 +156,11 @@ class BE2DReference(Kernel):
 
     name = "numpy"
 
+    def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
+        """Strain energy of each element (n_el,): ``sum_p w_p W(g_p, c_p)`` (Eqs. 82-88)."""
+        g, c = invariants(geom, q, order=0)
+        return np.sum(geom["w"] * densities(self.element, g, c, geom, order=1)[0], axis=1)
+
     def internal_forces(self, geom: dict, q: np.ndarray,
                         tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """``f = dU/dq_e`` (n_el, 8) and, if ``tangent``, ``K = df/dq_e`` (n_el, 8, 8)."""
@@ -295,10 +300,6 @@ class BE2D(Element):
     # -- kernels --------------------------------------------------------
     def mass_matrix(self, geom: dict) -> np.ndarray:
         return geom["M"]
-
-    def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
-        g, c = invariants(geom, q, order=0)
-        return np.sum(geom["w"] * densities(self, g, c, geom, order=1)[0], axis=1)
 
     def shape_matrix(self, s: ArrayLike, lengths: ArrayLike) -> np.ndarray:
         N, _, _ = hermite(np.asarray(s, dtype=float), lengths)

@@ -6,7 +6,8 @@ The same force and exact tangent as the NumPy reference :class:`.be2d.BE2DRefere
 quadrature points: on small meshes it removes the per-call overhead of some
 fifty NumPy operations on arrays of a few hundred entries. The tests compare
 the two on random deformed states. :class:`BE2DCompiled` is the kernel object;
-it also offers the fused assembly entry point :func:`be2d_fused`.
+it also offers the fused assembly entry point :func:`be2d_fused` and the strain
+energy of :mod:`.be2d_energy_numba`.
 
 Importing this module compiles (or loads) numba code; :mod:`.be2d` imports it
 only when the compiled kernel is selected.
@@ -22,11 +23,10 @@ from ...integrators._alpha_steps_numba import alpha_steps
 from ..beam.static_numba import static_newton
 from ...integrators._index3_steps_numba import index3_steps, system_multipliers
 from ..element import Kernel
+from .be2d_energy_numba import CONTINUUM, STRUCTURAL, be2d_energies, be2d_energy_fused
 
 __all__ = ["BE2DCompiled", "be2d_forces", "be2d_fused", "be2d_alpha_iterations", "be2d_alpha_steps",
            "be2d_static_newton", "be2d_index3_steps", "be2d_multipliers", "STRUCTURAL", "CONTINUUM"]
-
-STRUCTURAL, CONTINUUM = 0, 1
 
 
 @njit(cache=True, inline="always", fastmath={"contract"})
@@ -323,3 +323,12 @@ class BE2DCompiled(Kernel):
     def multipliers(self, geom: dict) -> tuple:
         """``(be2d_multipliers, args)``: a System's reactions at an output time (:mod:`ancfdae.system_compiled`)."""
         return be2d_multipliers, self._args(geom)
+
+    def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
+        """As :meth:`.be2d.BE2DReference.strain_energy`, compiled (:mod:`.be2d_energy_numba`)."""
+        return be2d_energies(np.ascontiguousarray(q, dtype=float), *self._args(geom))
+
+    def fused_energy(self, geom: dict) -> tuple:
+        """``(be2d_energy_fused, args)``: the beam's strain energy read through its gather (the optional kernel
+        method of :func:`ancfdae.models.beam.potential.beam_potential`)."""
+        return be2d_energy_fused, self._args(geom)
