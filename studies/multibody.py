@@ -22,6 +22,8 @@ Run: ``ancfdae study multibody [--quick] [--out DIR] [--jobs N]``.
 """
 from __future__ import annotations
 
+import math
+import numbers
 import sys
 
 import numpy as np
@@ -94,6 +96,36 @@ def _rtols_of(rtols, bm) -> tuple:
 def _per_benchmark(value, bm):
     """``value[bm]`` for a per-benchmark option (a dict), else ``value``."""
     return value[bm] if isinstance(value, dict) else value
+
+
+def _check_per_benchmark(o: dict) -> None:
+    """``steps``, ``t_end`` and ``n_out`` for every benchmark of the run: the common option check
+    (:func:`._common.settings`) sees no numbers inside a dict, so a dict is checked here, before any work.
+
+    Raises
+    ------
+    OptionError
+        Naming the option, the rule and the value.
+    """
+    def positive(x):
+        return not isinstance(x, bool) and isinstance(x, numbers.Real) and math.isfinite(x) and x > 0
+
+    def count(x):
+        return not isinstance(x, bool) and isinstance(x, numbers.Integral) and x >= 2
+
+    rules = {"steps": (lambda x: isinstance(x, (list, tuple)) and len(x) > 0 and all(positive(y) for y in x),
+                       "a non-empty sequence of positive finite steps per benchmark"),
+             "t_end": (positive, "a positive finite end time per benchmark"),
+             "n_out": (count, "an integer >= 2 (output times, both ends included), for all or per benchmark")}
+    for key, (ok, rule) in rules.items():
+        value = o[key]
+        per = value if isinstance(value, dict) else (None if key != "n_out" else {bm: value for bm in o["benchmarks"]})
+        if per is None:
+            raise OptionError(f"`{key}` must be a dict of {rule}, got {value!r}.")
+        bad = [bm for bm in o["benchmarks"] if bm not in per or not ok(per[bm])] + [k for k in per if k not in MODELS]
+        if bad:
+            raise OptionError(f"`{key}` must be {rule} {list(o['benchmarks'])}; wrong or missing for {bad}: "
+                              f"got {value!r}.")
 
 
 def _errors(rec, ref) -> dict:
@@ -183,6 +215,7 @@ def run(benchmarks=None, integrators=None, steps=None, rtols=None, t_end=None, r
            if isinstance(x, bool) or not isinstance(x, (int, float)) or not (np.isfinite(x) and x > 0)]
     if bad:
         raise OptionError(f"`rtols` must be positive finite tolerances (per benchmark or for all), got {o['rtols']!r}.")
+    _check_per_benchmark(o)
     path = output_dir("multibody", out, quick) if (plots or out is not None) else None
     cases, finest = [], {bm: min(o["steps"][bm]) for bm in o["benchmarks"]}
     for bm in o["benchmarks"]:

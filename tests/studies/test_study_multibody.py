@@ -148,3 +148,15 @@ def test_full_study_outputs_lie_on_every_step_grid():
         h_ref = min(full["steps"][bm]) / multibody.REFERENCE[bm][1]
         for h in list(full["steps"][bm]) + [h_ref, 2 * h_ref]:
             assert abs(dt / h - round(dt / h)) < 1e-9, (bm, h, dt)
+
+
+@pytest.mark.parametrize("option", [{"n_out": {"B6": 1}}, {"n_out": {"B5": 11}}, {"n_out": 2.5},
+                                    {"n_out": {"B6": 11, "B9": 11}}, {"steps": {"B6": (-1e-3,)}},
+                                    {"t_end": {"B6": float("nan")}}],
+                         ids=["n_out<2", "n_out-missing", "n_out-float", "n_out-unknown", "steps<0", "t_end-nan"])
+def test_per_benchmark_options_are_checked_before_any_work(option, tmp_path):
+    # Catches: a per-benchmark dict passed unchecked (the common check sees no numbers in a dict): n_out
+    # {"B6": 1} ran one output time, a missing benchmark raised a bare KeyError inside the sweep.
+    key = next(iter(option))
+    with pytest.raises(multibody.OptionError, match=f"`{key}`"):
+        multibody.run(benchmarks=["B6"], integrators=["newmark"], quick=True, out=tmp_path, progress=False, **option)
