@@ -157,8 +157,9 @@ def summarize(records: list[dict], methods) -> tuple:
         if r["reference"] or r["benchmark"] not in refs:
             continue
         e = _errors(r, refs[r["benchmark"]])
-        rows.append({k: r.get(k) for k in ("benchmark", "integrator", "h", "status", "cpu", "drift_q", "drift_v",
-                                            "energy_error", "momentum_error")} | {"error": e["q"], "error_lam": e["lam"]})
+        rows.append({k: r.get(k) for k in ("benchmark", "integrator", "h", "status", "t_fail", "cpu", "drift_q",
+                                            "drift_v", "energy_error", "momentum_error")}
+                    | {"error": e["q"], "error_lam": e["lam"]})
     orders, orders_lam, local = {}, {}, {}
     for bm in refs:
         for m in methods:
@@ -273,10 +274,16 @@ def _order_cell(orders, local, bm, m, kind) -> str:
     return "(" + ", ".join(f"{x:.2f}" for x in loc) + ")" if loc else "-"
 
 
+def _status_cell(row) -> str:
+    """The run's status, with the time of the step that failed (where the run stopped)."""
+    t_fail = row.get("t_fail")
+    return f"{row['status']} at {t_fail:.4g} s" if row["status"] != "success" and t_fail is not None else row["status"]
+
+
 def _table(rows, orders, orders_lam, local, refs, floors, errors) -> str:
     headers = ["benchmark", "integrator", "h (s) or rtol", "status", "error q", "order q", "error lambda",
                "order lambda", "max |g|", "max |G v + g_t|", "energy error (B7)", "L_z drift (B7)", "CPU (s)"]
-    body = [[r["benchmark"], r["integrator"], f"{r['h']:g}", r["status"], cell(r["error"], ".2e"),
+    body = [[r["benchmark"], r["integrator"], f"{r['h']:g}", _status_cell(r), cell(r["error"], ".2e"),
              _order_cell(orders, local, r["benchmark"], r["integrator"], "q"), cell(r["error_lam"], ".2e"),
              _order_cell(orders_lam, local, r["benchmark"], r["integrator"], "lam"), cell(r["drift_q"], ".1e"),
              cell(r["drift_v"], ".1e"), cell(r["energy_error"], ".1e"), cell(r["momentum_error"], ".1e"),

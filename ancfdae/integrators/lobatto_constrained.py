@@ -207,7 +207,8 @@ class GGLStages:
     # -- Newton matrix -------------------------------------------------------------------------
     def blocks(self, x, t, h, stages):
         """Per-stage ``(Kt = K + H(Lam_i), D, M, G, W)`` at the given stages (one set repeated when
-        ``stages`` has one entry) and the round-off floor of the largest stiffness."""
+        ``stages`` has one entry) and the residual's round-off floor: that of the largest stiffness, the
+        elastic ``K`` or the scaled position rows' ``(m_s / h^2) G``."""
         st, model = self.stepper, self.stepper.model
         ts, Q, V, A, L, U = self.states(x, t, h)
         out, floor = [], 0.0
@@ -217,7 +218,10 @@ class GGLStages:
             G = sp.csr_matrix(model.constraint_jacobian(ts[i], Q[:, i]))
             W = as_csr(velocity_constraint_jacobian(model, ts[i], Q[:, i], V[:, i]))
             out.append((Kt, sp.csr_matrix(blk.D), sp.csr_matrix(blk.M), G, W))
-            floor = max(floor, st.floor_of(blk.K, Q[:, i]))
+            # the position rows (m_s / h^2) g are a stiffness (m_s / h^2) G on Q: at small steps their
+            # round-off outgrows the elastic forces' (B7, h = 3.125e-4: max|r| stalled at 5.7e-10 N in
+            # those rows against a floor of 2.5e-10 N from K, Newton ended "diverging" at t = 0)
+            floor = max(floor, st.floor_of(blk.K, Q[:, i]), st.floor_of(G, Q[:, i]) * (self.ms / (h * h)))
         if len(out) == 1:
             out = out * self.ns
         return ReducedMatrix(self, out, h), floor
@@ -322,7 +326,8 @@ def _full_newton(stepper, residual, jacobian, guess):
     Modified Newton can fail a step that Newton solves in 3-4 iterations: on B5 (spin-up, BE2D 8 elements,
     no numerical dissipation) the first residual grows with the unresolved stiff modes the method keeps
     (1e3 N at 5 s, 1e5 N at 7.8 s, h = 0.05) and a matrix kept over iterations no longer contracts there;
-    modified Newton stopped at 7.8 s (h = 0.05) and 6.8 s (h = 0.1), full Newton at 10.25 and 9.4 s.
+    modified Newton stopped at 7.8 s (h = 0.05) and 6.8 s (h = 0.1; 7.4 s with the constraint rows' floor in
+    :meth:`GGLStages.blocks`), full Newton at 10.25 and 9.4 s.
     The options are swapped for this one solve only; the matrix it leaves (at the converged stages) is the
     next step's modified-Newton matrix.
     """
