@@ -9,7 +9,8 @@ method at twice its step: their difference bounds the reference's own error (the
 table gives it), and a run whose error is within :data:`FLOOR` times that bound does not enter an order
 (a reference of a second-order method, as generalized-alpha at h/2 was, is as coarse as the runs of the
 fourth-order methods, whose orders then meant nothing). Per run: the errors of the position outputs and of
-the multiplier outputs (hub torque, slider normal force, crank torque, pivot force; each output relative
+the multiplier outputs (hub torque, slider normal force, crank torque, B7's pivot force as its mean over each
+output interval; each output relative
 to the reference's largest value, the largest over the kind), the position drift ``max |g|`` and the
 velocity drift ``max |G v + g_t|`` over the outputs, on B7 the energy error ``max |E - E0|`` relative to
 the largest kinetic energy and the drift of the angular momentum about the vertical, the CPU time; per
@@ -38,13 +39,13 @@ from ._tables import cell, errors_note, markdown_table
 __all__ = ["run", "run_case", "summarize", "FULL", "QUICK", "CLI_OPTIONS", "constrained_methods"]
 
 #: the reference method per benchmark and how much finer than the finest step it runs (its check: at twice
-#: its step). Lobatto IIIA-3 where it runs the whole span: B7 4 times finer, so that its error bound (the
-#: difference from the check) lies 10x below the fourth-order methods' finest errors; B6 only 2 times finer
-#: (bound 8.4e-7, the finest errors of Lobatto IIIA-3 and energy-collocation: those runs then enter no order)
-#: because at h = 5e-5 Lobatto IIIA-3 stops at t = 0.11 s (Newton "diverging, rate 1 with a fresh Jacobian":
-#: stagnation at round-off). On the 30-s B5 every method without numerical dissipation fails
+#: its step). Lobatto IIIA-3 where it runs the whole span: B7 16 times finer (3.125e-4 s), where its
+#: interval-mean pivot force has converged to 9.1e-4 against the check (4 times finer: 6.2e-3; docs/studies.md,
+#: "B7: the pivot force"); B6 2 times finer (bound 8.4e-7, the finest errors of Lobatto IIIA-3 and
+#: energy-collocation: those runs then enter no order; 5e-5 s stopped at t = 0.11 s before the GGL floor
+#: covered the constraint rows). On the 30-s B5 every method without numerical dissipation fails
 #: (docs/studies.md, "B5: why the non-dissipative methods fail"), so B5's reference is generalized-alpha 8x finer.
-REFERENCE = {"B5": ("generalized-alpha", 8), "B6": ("lobatto3", 2), "B7": ("lobatto3", 4)}
+REFERENCE = {"B5": ("generalized-alpha", 8), "B6": ("lobatto3", 2), "B7": ("lobatto3", 16)}
 #: a run whose error is below FLOOR times the reference's error bound does not enter an order
 FLOOR = 10.0
 #: CPU per step relative to generalized-alpha, measured in the full run at e1b9706 (B6 and B7, finest
@@ -292,7 +293,8 @@ def _table(rows, orders, orders_lam, local, refs, floors, errors) -> str:
         f"{bm} {r['integrator']} at h = {r['h']:g} s (differs from the run at 2h by {cell(floors[bm]['q'], '.1e')} in q, "
         f"{cell(floors[bm]['lam'], '.1e')} in lambda)" for bm, r in refs.items()) + \
         ". Errors: largest over the position (q) or multiplier (lambda: hub torque, slider normal force, crank " \
-        "torque, pivot force) outputs, each relative to the reference's largest value. Order: only from " \
+        "torque; B7: the pivot force's mean over each output interval, from the momentum balance) outputs, " \
+        "each relative to the reference's largest value. Order: only from " \
         f"asymptotic runs (studies/_orders.py): runs whose error exceeds {FLOOR:g} times the reference's " \
         "difference from its check, the finest chain of at least two successive local orders (log error " \
         f"ratio over log h ratio; IDA: over log rtol ratio) that agree within {ORDER_TOL:.0%}, fitted; " \
