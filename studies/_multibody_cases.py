@@ -24,7 +24,7 @@ MODELS = {"B5": ("BE2D", 8, {"w_s": 4.0}), "B6": ("BE2D", 8, {}), "B7": ("Cable3
 #: options per method (beyond h)
 OPTIONS = {"hht": {"alpha": 0.05}, "generalized-alpha": {"rho_inf": 0.8}}
 #: the outputs that are multipliers (reactions); the others but the invariants are positions
-MULTIPLIER_OUTPUTS = ("hub_torque", "slider_normal_force", "crank_torque", "pivot_force_z")
+MULTIPLIER_OUTPUTS = ("hub_torque", "slider_normal_force", "crank_torque", "pivot_force_mean_z")
 INVARIANTS = ("energy", "angular_momentum_z")
 
 
@@ -66,8 +66,8 @@ def outputs(record: dict) -> dict:
     g_t = np.abs(g).max(axis=1) if g.size else np.zeros(res.t.size)
     gv_t = np.abs(gv).max(axis=1) if gv.size else np.zeros(res.t.size)
     rec = {k: v for k, v in record.items() if k != "result"}
-    rec.update(t=res.t, out=out, status=res.status, message=res.message, drift_q_t=g_t, drift_v_t=gv_t,
-               drift_q=float(g_t.max()) if g.size else float("nan"),
+    rec.update(t=res.t, out=out, status=res.status, message=res.message, t_fail=res.t_fail, drift_q_t=g_t,
+               drift_v_t=gv_t, drift_q=float(g_t.max()) if g.size else float("nan"),
                drift_v=float(gv_t.max()) if gv.size else float("nan"))
     if "energy" in out and res.t.size:
         T = np.array([s.energy(t, q, v).kinetic for t, q, v in zip(res.t, res.q, res.v)])

@@ -9,7 +9,8 @@ method at twice its step: their difference bounds the reference's own error (the
 table gives it), and a run whose error is within :data:`FLOOR` times that bound does not enter an order
 (a reference of a second-order method, as generalized-alpha at h/2 was, is as coarse as the runs of the
 fourth-order methods, whose orders then meant nothing). Per run: the errors of the position outputs and of
-the multiplier outputs (hub torque, slider normal force, crank torque, pivot force; each output relative
+the multiplier outputs (hub torque, slider normal force, crank torque, B7's pivot force as its mean over each
+output interval; each output relative
 to the reference's largest value, the largest over the kind), the position drift ``max |g|`` and the
 velocity drift ``max |G v + g_t|`` over the outputs, on B7 the energy error ``max |E - E0|`` relative to
 the largest kinetic energy and the drift of the angular momentum about the vertical, the CPU time; per
@@ -22,6 +23,8 @@ Run: ``ancfdae study multibody [--quick] [--out DIR] [--jobs N]``.
 """
 from __future__ import annotations
 
+import math
+import numbers
 import sys
 
 import numpy as np
@@ -36,13 +39,13 @@ from ._tables import cell, errors_note, markdown_table
 __all__ = ["run", "run_case", "summarize", "FULL", "QUICK", "CLI_OPTIONS", "constrained_methods"]
 
 #: the reference method per benchmark and how much finer than the finest step it runs (its check: at twice
-#: its step). Lobatto IIIA-3 where it runs the whole span: B7 4 times finer, so that its error bound (the
-#: difference from the check) lies 10x below the fourth-order methods' finest errors; B6 only 2 times finer
-#: (bound 8.4e-7, the finest errors of Lobatto IIIA-3 and energy-collocation: those runs then enter no order)
-#: because at h = 5e-5 Lobatto IIIA-3 stops at t = 0.11 s (Newton "diverging, rate 1 with a fresh Jacobian":
-#: stagnation at round-off). On the 30-s B5 every method without numerical dissipation fails
+#: its step). Lobatto IIIA-3 where it runs the whole span: B7 16 times finer (3.125e-4 s), where its
+#: interval-mean pivot force has converged to 9.1e-4 against the check (4 times finer: 6.2e-3; docs/studies.md,
+#: "B7: the pivot force"); B6 2 times finer (bound 8.4e-7, the finest errors of Lobatto IIIA-3 and
+#: energy-collocation: those runs then enter no order; 5e-5 s stopped at t = 0.11 s before the GGL floor
+#: covered the constraint rows). On the 30-s B5 every method without numerical dissipation fails
 #: (docs/studies.md, "B5: why the non-dissipative methods fail"), so B5's reference is generalized-alpha 8x finer.
-REFERENCE = {"B5": ("generalized-alpha", 8), "B6": ("lobatto3", 2), "B7": ("lobatto3", 4)}
+REFERENCE = {"B5": ("generalized-alpha", 8), "B6": ("lobatto3", 2), "B7": ("lobatto3", 16)}
 #: a run whose error is below FLOOR times the reference's error bound does not enter an order
 FLOOR = 10.0
 #: CPU per step relative to generalized-alpha, measured in the full run at e1b9706 (B6 and B7, finest
@@ -96,6 +99,36 @@ def _per_benchmark(value, bm):
     return value[bm] if isinstance(value, dict) else value
 
 
+def _check_per_benchmark(o: dict) -> None:
+    """``steps``, ``t_end`` and ``n_out`` for every benchmark of the run: the common option check
+    (:func:`._common.settings`) sees no numbers inside a dict, so a dict is checked here, before any work.
+
+    Raises
+    ------
+    OptionError
+        Naming the option, the rule and the value.
+    """
+    def positive(x):
+        return not isinstance(x, bool) and isinstance(x, numbers.Real) and math.isfinite(x) and x > 0
+
+    def count(x):
+        return not isinstance(x, bool) and isinstance(x, numbers.Integral) and x >= 2
+
+    rules = {"steps": (lambda x: isinstance(x, (list, tuple)) and len(x) > 0 and all(positive(y) for y in x),
+                       "a non-empty sequence of positive finite steps per benchmark"),
+             "t_end": (positive, "a positive finite end time per benchmark"),
+             "n_out": (count, "an integer >= 2 (output times, both ends included), for all or per benchmark")}
+    for key, (ok, rule) in rules.items():
+        value = o[key]
+        per = value if isinstance(value, dict) else (None if key != "n_out" else {bm: value for bm in o["benchmarks"]})
+        if per is None:
+            raise OptionError(f"`{key}` must be a dict of {rule}, got {value!r}.")
+        bad = [bm for bm in o["benchmarks"] if bm not in per or not ok(per[bm])] + [k for k in per if k not in MODELS]
+        if bad:
+            raise OptionError(f"`{key}` must be {rule} {list(o['benchmarks'])}; wrong or missing for {bad}: "
+                              f"got {value!r}.")
+
+
 def _errors(rec, ref) -> dict:
     """``{"q": ..., "lam": ...}``: the largest error of the position and of the multiplier outputs against
     the reference, each output relative to the reference's largest value (NaN when a run stopped early)."""
@@ -125,8 +158,9 @@ def summarize(records: list[dict], methods) -> tuple:
         if r["reference"] or r["benchmark"] not in refs:
             continue
         e = _errors(r, refs[r["benchmark"]])
-        rows.append({k: r.get(k) for k in ("benchmark", "integrator", "h", "status", "cpu", "drift_q", "drift_v",
-                                            "energy_error", "momentum_error")} | {"error": e["q"], "error_lam": e["lam"]})
+        rows.append({k: r.get(k) for k in ("benchmark", "integrator", "h", "status", "t_fail", "cpu", "drift_q",
+                                            "drift_v", "energy_error", "momentum_error")}
+                    | {"error": e["q"], "error_lam": e["lam"]})
     orders, orders_lam, local = {}, {}, {}
     for bm in refs:
         for m in methods:
@@ -183,6 +217,7 @@ def run(benchmarks=None, integrators=None, steps=None, rtols=None, t_end=None, r
            if isinstance(x, bool) or not isinstance(x, (int, float)) or not (np.isfinite(x) and x > 0)]
     if bad:
         raise OptionError(f"`rtols` must be positive finite tolerances (per benchmark or for all), got {o['rtols']!r}.")
+    _check_per_benchmark(o)
     path = output_dir("multibody", out, quick) if (plots or out is not None) else None
     cases, finest = [], {bm: min(o["steps"][bm]) for bm in o["benchmarks"]}
     for bm in o["benchmarks"]:
@@ -240,10 +275,16 @@ def _order_cell(orders, local, bm, m, kind) -> str:
     return "(" + ", ".join(f"{x:.2f}" for x in loc) + ")" if loc else "-"
 
 
+def _status_cell(row) -> str:
+    """The run's status, with the time of the step that failed (where the run stopped)."""
+    t_fail = row.get("t_fail")
+    return f"{row['status']} at {t_fail:.4g} s" if row["status"] != "success" and t_fail is not None else row["status"]
+
+
 def _table(rows, orders, orders_lam, local, refs, floors, errors) -> str:
     headers = ["benchmark", "integrator", "h (s) or rtol", "status", "error q", "order q", "error lambda",
                "order lambda", "max |g|", "max |G v + g_t|", "energy error (B7)", "L_z drift (B7)", "CPU (s)"]
-    body = [[r["benchmark"], r["integrator"], f"{r['h']:g}", r["status"], cell(r["error"], ".2e"),
+    body = [[r["benchmark"], r["integrator"], f"{r['h']:g}", _status_cell(r), cell(r["error"], ".2e"),
              _order_cell(orders, local, r["benchmark"], r["integrator"], "q"), cell(r["error_lam"], ".2e"),
              _order_cell(orders_lam, local, r["benchmark"], r["integrator"], "lam"), cell(r["drift_q"], ".1e"),
              cell(r["drift_v"], ".1e"), cell(r["energy_error"], ".1e"), cell(r["momentum_error"], ".1e"),
@@ -252,7 +293,8 @@ def _table(rows, orders, orders_lam, local, refs, floors, errors) -> str:
         f"{bm} {r['integrator']} at h = {r['h']:g} s (differs from the run at 2h by {cell(floors[bm]['q'], '.1e')} in q, "
         f"{cell(floors[bm]['lam'], '.1e')} in lambda)" for bm, r in refs.items()) + \
         ". Errors: largest over the position (q) or multiplier (lambda: hub torque, slider normal force, crank " \
-        "torque, pivot force) outputs, each relative to the reference's largest value. Order: only from " \
+        "torque; B7: the pivot force's mean over each output interval, from the momentum balance) outputs, " \
+        "each relative to the reference's largest value. Order: only from " \
         f"asymptotic runs (studies/_orders.py): runs whose error exceeds {FLOOR:g} times the reference's " \
         "difference from its check, the finest chain of at least two successive local orders (log error " \
         f"ratio over log h ratio; IDA: over log rtol ratio) that agree within {ORDER_TOL:.0%}, fitted; " \

@@ -135,6 +135,19 @@ def _lagrange_weights(nodes, points):
     return W
 
 
+def _check_predictor(predictor: str, model) -> None:
+    """Refuse ``predictor="extrapolate"`` on a constrained model, whose GGL stage system always starts from
+    ``K_i = v_n + c_i h a_n``, ``A_i = a_n``, ``Lam_i = lam_n`` (it used to be ignored there silently).
+
+    Not implemented there because it did not help where it was tried: on B5 (spin-up, BE2D 8 elements)
+    stage values continued from the last step stopped h = 0.1 at the same 6.8 s and h = 0.05 earlier
+    (docs/studies.md, "B5: why the non-dissipative methods fail").
+    """
+    if predictor == "extrapolate" and "constraints" in capabilities(model):
+        raise ValueError("`predictor` must be 'constant' for a model with constraints (the GGL stage system "
+                         "of Lobatto IIIA has no extrapolating predictor), got 'extrapolate'.")
+
+
 class LobattoIIIA(NewtonStepper):
     """Lobatto IIIA, fixed step, (modified) Newton on the stage accelerations.
 
@@ -162,8 +175,9 @@ class LobattoIIIA(NewtonStepper):
     A model with the ``"constraints"`` capability is integrated in the stabilised index-2 (GGL) form
     with a reduced stage system (:mod:`ancfdae.integrators.lobatto_constrained`): order 4 in q and v
     on linear, quadratic and rheonomic constraints, ``g`` and ``G v + g_t`` held at every step to the
-    Newton tolerance; the step's multipliers are returned in ``StepOutcome.lam`` (the predictor is
-    always "constant" there).
+    Newton tolerance; the step's multipliers are returned in ``StepOutcome.lam``. There the predictor must
+    be "constant" (``ValueError`` otherwise), and a step that modified Newton fails with per-stage blocks
+    gets a last attempt with full Newton.
     """
 
     handles_constraints = True
@@ -182,6 +196,7 @@ class LobattoIIIA(NewtonStepper):
                              "accurate (Lobatto IIIA type).")
         self.tableau = tab
         self.predictor = validate.choice("predictor", predictor, ("extrapolate", "constant"))
+        _check_predictor(self.predictor, model)
         self.name = f"lobatto{tab.stages}"
         self.order = tab.order
         s = tab.stages
@@ -211,6 +226,7 @@ class LobattoIIIA(NewtonStepper):
         self._stages = "residual_stages" in capabilities(self.model)   # declared, forwarded by the proxy
         self._ggl = None
         if "constraints" in capabilities(self.model):   # constrained: the GGL stage system (lobatto_constrained)
+            _check_predictor(self.predictor, self.model)
             if self.lam is None:          # no multipliers given: (a0, lam0) from the KKT system
                 self.a, self.lam = multipliers(self.model, self.t, self.q, self.v)
             self._ggl = GGLStages(self)

@@ -38,6 +38,8 @@ stage for every stage; when that fails a step, the step is retried with per-stag
 """
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -205,7 +207,8 @@ class GGLStages:
     # -- Newton matrix -------------------------------------------------------------------------
     def blocks(self, x, t, h, stages):
         """Per-stage ``(Kt = K + H(Lam_i), D, M, G, W)`` at the given stages (one set repeated when
-        ``stages`` has one entry) and the round-off floor of the largest stiffness."""
+        ``stages`` has one entry) and the residual's round-off floor: that of the largest stiffness, the
+        elastic ``K`` or the scaled position rows' ``(m_s / h^2) G``."""
         st, model = self.stepper, self.stepper.model
         ts, Q, V, A, L, U = self.states(x, t, h)
         out, floor = [], 0.0
@@ -215,7 +218,10 @@ class GGLStages:
             G = sp.csr_matrix(model.constraint_jacobian(ts[i], Q[:, i]))
             W = as_csr(velocity_constraint_jacobian(model, ts[i], Q[:, i], V[:, i]))
             out.append((Kt, sp.csr_matrix(blk.D), sp.csr_matrix(blk.M), G, W))
-            floor = max(floor, st.floor_of(blk.K, Q[:, i]))
+            # the position rows (m_s / h^2) g are a stiffness (m_s / h^2) G on Q: at small steps their
+            # round-off outgrows the elastic forces' (B7, h = 3.125e-4: max|r| stalled at 5.7e-10 N in
+            # those rows against a floor of 2.5e-10 N from K, Newton ended "diverging" at t = 0)
+            floor = max(floor, st.floor_of(blk.K, Q[:, i]), st.floor_of(G, Q[:, i]) * (self.ms / (h * h)))
         if len(out) == 1:
             out = out * self.ns
         return ReducedMatrix(self, out, h), floor
@@ -314,6 +320,27 @@ class _ReducedFactor:
         return np.concatenate([dK.ravel(), dA.ravel(), dL.ravel(), dU.ravel()])
 
 
+def _full_newton(stepper, residual, jacobian, guess):
+    """The step's last attempt: full Newton (a fresh per-stage matrix every iteration) from the guess.
+
+    Modified Newton can fail a step that Newton solves in 3-4 iterations: on B5 (spin-up, BE2D 8 elements,
+    no numerical dissipation) the first residual grows with the unresolved stiff modes the method keeps
+    (1e3 N at 5 s, 1e5 N at 7.8 s, h = 0.05) and a matrix kept over iterations no longer contracts there;
+    modified Newton stopped at 7.8 s (h = 0.05) and 6.8 s (h = 0.1; 7.4 s with the constraint rows' floor in
+    :meth:`GGLStages.blocks`), full Newton at 10.25 and 9.4 s.
+    The options are swapped for this one solve only; the matrix it leaves (at the converged stages) is the
+    next step's modified-Newton matrix.
+    """
+    newton = stepper.newton
+    options = newton.options
+    newton.options = replace(options, jacobian="full")
+    newton.invalidate()
+    try:
+        return stepper._solve(residual, jacobian, guess)
+    finally:
+        newton.options = options
+
+
 def ggl_step(stepper, system: GGLStages, t: float, h: float) -> StepOutcome:
     """One Lobatto IIIA step of the GGL form from the stepper's state; the state is not changed."""
     last = [system.ns - 1]
@@ -333,6 +360,8 @@ def ggl_step(stepper, system: GGLStages, t: float, h: float) -> StepOutcome:
         per_stage[0] = True
         stepper.newton.invalidate()
         out = stepper._solve(residual, jacobian, guess)
+    if not out.converged and stepper.newton.options.jacobian == "modified":
+        out = _full_newton(stepper, residual, jacobian, guess)
     if not out.converged:
         return StepOutcome.failure(f"Newton (GGL stage system): {out.message}")
     ts, Q, V, A, L, U = system.states(out.x, t, h)

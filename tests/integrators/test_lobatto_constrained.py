@@ -121,3 +121,30 @@ def test_through_the_driver():
     assert res.success
     for t, q in zip(res.t, res.q):
         assert np.abs(model.constraints(t, q)).max() < 1e-12
+
+
+def test_constrained_lobatto_refuses_the_extrapolating_predictor():
+    # Catches: predictor="extrapolate" accepted and silently ignored on a constrained model (the GGL stage
+    # system has only the constant guess).
+    with pytest.raises(ValueError, match="`predictor`"):
+        Lobatto3(hanging_link(), 0.01, predictor="extrapolate")
+
+
+def test_modified_newton_step_falls_back_to_full_newton():
+    # Catches: the modified-Newton policy failing a step that full Newton solves (B5 spin-up, BE2D 8 elements,
+    # h = 0.1: modified Newton stopped at t = 7.4 s, full Newton at 9.4 s; with the fallback 9.4 s).
+    from ancfdae import simulate
+    from ancfdae.studies._multibody_models import spinup
+    res = simulate(spinup("BE2D", 8).system, (0.0, 8.5), "lobatto3", h=0.1, t_eval=[0.0, 8.5])
+    assert res.success, res.message
+
+
+def test_round_off_floor_covers_the_scaled_position_rows():
+    # Catches: a Newton floor from the elastic stiffness alone. The position rows (m_s / h^2) g stall at their
+    # own round-off, which outgrows the elastic forces' at small steps: B7 (Cable3D 4 el, E = 5e7) at
+    # h = 3.125e-4 stalled at 5.7e-10 N (floor 2.5e-10 N) and failed its first step "diverging".
+    from ancfdae import simulate
+    from ancfdae.studies._multibody_models import spatial_pendulum
+    h = 3.125e-4
+    res = simulate(spatial_pendulum("Cable3D", 4, E=5e7).system, (0.0, 4 * h), "lobatto3", h=h)
+    assert res.success, res.message
