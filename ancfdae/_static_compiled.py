@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from .integrators._linsolve import COMPILED_SOLVE_MAX, _band_map, use_banded
+from .integrators import _newton_messages as says
 from .integrators._newton import DIVERGENCE_RATE
 from .integrators._newton_records import NewtonOutcome
 from .models.beam import static_numba as sn
@@ -77,19 +78,19 @@ class CompiledStatic:
 
 
 def _message(status, k, err, rate, threshold, max_iter):
-    """The :class:`~ancfdae.integrators._newton.NewtonSolver`'s message for each way a solve ends."""
+    """The :class:`~ancfdae.integrators._newton.NewtonSolver`'s message for the compiled solve's ending ``status``."""
     if status == sn.CONVERGED_INITIAL:
-        return "converged at the initial guess"
+        return says.converged_initial()
     if status == sn.CONVERGED:
-        return f"converged in {k} iterations"
+        return says.converged(k)
     if status == sn.STAGNANT:
-        return f"converged in {k} iterations (correction at round-off level, max|r| = {err:.3e})"
+        return says.stagnant(k, err)
     if status == sn.INITIAL_NOT_FINITE:
-        return "residual at the initial guess is not finite"
+        return says.initial_not_finite()
     if status == sn.DX_NOT_FINITE:
-        return "Newton correction is not finite (singular iteration matrix?)"
+        return says.dx_not_finite()
     if status == sn.R_NOT_FINITE:
-        return f"residual became non-finite at iteration {k}"
+        return says.r_not_finite(k)
     if status == sn.DIVERGING:
-        return f"diverging (rate {rate:.3g} at iteration {k} with a fresh Jacobian)"
-    return f"not converged in {max_iter} iterations (max|r| = {err:.3e}, target {threshold:.3e})"
+        return says.diverging(rate, k)
+    return says.not_converged(max_iter, err, threshold)

@@ -1,11 +1,14 @@
-"""solve_static's compiled load step (BE2D, full Newton) equals the Python iteration: states, counters, messages.
+"""solve_static's compiled load step (BE2D, full Newton) equals the Python iteration: decisions, counters, messages,
+and states to round-off.
 
 The Python iteration is reached by refusing the offer (``CompiledStatic.offer`` returning None), so both runs
-solve the same beam. Catches: a residual rounded differently (``f + 0 - lam f_ext``), a tangent factorised
-differently from LAPACK's, a decision taken in another order (converged / round-off stagnation / the rate tests),
+solve the same beam. Catches: a residual or tangent computed differently beyond round-off (states to 1e-12 of
+their size; bitwise equality with LAPACK's factorisation holds on some CPUs only), a decision taken in another order (converged / round-off stagnation / the rate tests),
 a counter or message that differs from the solver's, a wrong load factor or external force (gravity, dead
 loads with a time function), and the offer taken where it must not be (moments, modified Newton).
 """
+import re
+
 import numpy as np
 import pytest
 
@@ -35,13 +38,31 @@ def _both(make, monkeypatch, **kw):
 
 
 def _same(a, b):
-    assert a.status == b.status and a.message == b.message
-    assert np.array_equal(a.q, b.q)
+    """Equal decisions, counters and messages; states equal to round-off.
+
+    The Python iteration factorises with LAPACK (scipy), the compiled one with its own banded LU: both
+    follow the same pivoting, but OpenBLAS picks its kernels by CPU (AVX-512 and AVX2 round differently),
+    so bitwise equality of the states holds on some machines only (seen: an AMD EPYC with AVX-512 differs
+    in the last bit). Residuals at the round-off floor are compared to that floor.
+    """
+    assert a.status == b.status
+    assert _no_numbers(a.message) == _no_numbers(b.message)
     assert {k: v for k, v in a.stats.items() if k != "cpu_time"} == {k: v for k, v in b.stats.items() if k != "cpu_time"}
-    assert [(s["iterations"], s["residual"], s["converged"]) for s in a.steps] == \
-        [(s["iterations"], s["residual"], s["converged"]) for s in b.steps]
+    assert [(s["iterations"], s["converged"]) for s in a.steps] == [(s["iterations"], s["converged"]) for s in b.steps]
+    scale = max(np.abs(b.q).max(), 1.0)
+    np.testing.assert_allclose(a.q, b.q, rtol=0, atol=1e-12 * scale)
     for sa, sb in zip(a.steps, b.steps):
-        assert np.array_equal(sa["q"], sb["q"])
+        np.testing.assert_allclose(sa["q"], sb["q"], rtol=0, atol=1e-12 * scale)
+        # An unconverged step's residual agrees to many digits; a converged one's lies at the round-off floor,
+        # a diverging one's (a near-singular tangent) is round-off amplified: neither is compared.
+        if not sa["converged"] and "diverging" not in a.message:
+            assert abs(sa["residual"] - sb["residual"]) <= 1e-6 * abs(sb["residual"]), (sa, sb)
+
+
+def _no_numbers(message):
+    """A message with its printed reals removed (residuals at the floor; a near-singular tangent's rate, which
+    round-off decides), its integers (iterations, load steps) kept."""
+    return re.sub(r"\d+\.\d*(e[+-]?\d+)?|\d+e[+-]?\d+", "*", message)
 
 
 @pytest.mark.parametrize("formulation", ["structural", "continuum"])

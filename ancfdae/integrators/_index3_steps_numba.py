@@ -37,7 +37,7 @@ from numba import njit
 from ancfdae.integrators._linsolve_numba import band_solve
 from ancfdae._scale import max_abs
 from ancfdae.joints.assembled_numba import _g_force, _rates
-from ancfdae.models.beam.assembly_numba import finish_residual
+from ancfdae._residual_numba import finish_residual
 
 __all__ = ["index3_steps", "system_multipliers", "dense_lu", "dense_solve"]
 

@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike
 
 from .._scale import max_abs
 from ._linsolve import factorize
+from . import _newton_messages as says
 from ._newton_records import NewtonOptions, NewtonOutcome, NewtonStats
 
 __all__ = ["NewtonSolver"]
@@ -212,7 +213,7 @@ class NewtonSolver:
             r, J = self._eval(residual, x0), None
         if not math.isfinite(max_abs(r)):
             self.stats.failed_solves += 1
-            return NewtonOutcome(x0, False, 0, float("nan"), "residual at the initial guess is not finite", floor)
+            return NewtonOutcome(x0, False, 0, float("nan"), says.initial_not_finite(), floor)
         if fused is not None:
             iterate = None
         outcome, stale = self._attempt(residual, jacobian, x0, r, residual_atol, floor, keep_max, fused, J, iterate,
@@ -253,7 +254,7 @@ class NewtonSolver:
         rel = max(opts.tol * err0, atol)
         threshold = max(rel, floor)
         if err <= threshold and (accept is None or accept(x, r) <= 1.0):
-            return NewtonOutcome(x, True, 0, err, "converged at the initial guess", floor), stale
+            return NewtonOutcome(x, True, 0, err, says.converged_initial(), floor), stale
         polish = err <= threshold   # below the residual test, not accepted: iterate on while the correction halves
         dx_last = np.inf
         fresh = False  # the cached matrix was evaluated during this attempt
@@ -279,15 +280,13 @@ class NewtonSolver:
                 finite = math.isfinite(dx_max)
                 self.stats.residual_evals += n if finite else n - 1
                 if not finite:
-                    return NewtonOutcome(x, False, k, err, "Newton correction is not finite "
-                                         "(singular iteration matrix?)", floor), stale
+                    return NewtonOutcome(x, False, k, err, says.dx_not_finite(), floor), stale
             else:
                 dx = self._lu.solve(r)   # the correction is -dx (negation commutes exactly with the solve)
                 self.stats.iterations += 1
                 dx_max = max_abs(dx)  # NaN/inf propagate into the max
                 if not math.isfinite(dx_max):   # math: 20x cheaper than np on a float
-                    return NewtonOutcome(x, False, k, err, "Newton correction is not finite "
-                                         "(singular iteration matrix?)", floor), stale
+                    return NewtonOutcome(x, False, k, err, says.dx_not_finite(), floor), stale
                 x = x - dx
                 if fused is not None:
                     r, J = self._eval_fused(fused, x)
@@ -296,27 +295,24 @@ class NewtonSolver:
                 err_new = max_abs(r)
             if not math.isfinite(err_new):
                 return NewtonOutcome(x, False, k, float("nan"),
-                                     f"residual became non-finite at iteration {k}", floor), stale
+                                     says.r_not_finite(k), floor), stale
             # Round-off stagnation: a fresh matrix, a correction at round-off
             # level and a residual that no longer falls -- the attainable accuracy.
             stagnant = (err_new > threshold and fresh and err_new > 0.5 * err
                         and dx_max <= opts.xtol * max(1.0, max_abs(x)))
             if accept is None and err_new <= threshold:
-                return NewtonOutcome(x, True, k, err_new, f"converged in {k} iterations", floor), stale
+                return NewtonOutcome(x, True, k, err_new, says.converged(k), floor), stale
             if accept is None and stagnant:
-                return NewtonOutcome(x, True, k, err_new, f"converged in {k} iterations "
-                                     f"(correction at round-off level, max|r| = {err_new:.3e})", floor), stale
+                return NewtonOutcome(x, True, k, err_new, says.stagnant(k, err_new), floor), stale
             if accept is not None and (polish or stagnant or err_new <= threshold):
                 ratio = accept(x, r)
                 if ratio <= 1.0:
-                    return NewtonOutcome(x, True, k, err_new, f"converged in {k} iterations", floor), stale
+                    return NewtonOutcome(x, True, k, err_new, says.converged(k), floor), stale
                 if ratio <= ACCEPT_AFTER_CORRECTION:
                     self.stats.iterations += 1
-                    return NewtonOutcome(x - self._lu.solve(r), True, k + 1, err_new, f"converged in {k + 1} "
-                                         "iterations (the last one without its residual)", floor), stale
+                    return NewtonOutcome(x - self._lu.solve(r), True, k + 1, err_new, says.last_without_residual(k + 1), floor), stale
                 if polish and not dx_max <= 0.5 * dx_last:
-                    return NewtonOutcome(x, True, k, err_new, f"converged in {k} iterations (the correction "
-                                         f"stalled at round-off, max|dx| = {dx_max:.3e})", floor), stale
+                    return NewtonOutcome(x, True, k, err_new, says.stalled(k, dx_max), floor), stale
                 polish, dx_last, err = True, dx_max, err_new
                 continue           # the matrix kept: a residual at its floor says nothing about the rate
             rate = err_new / err if err > 0 else np.inf
@@ -325,8 +321,7 @@ class NewtonSolver:
                 if fresh and rate >= DIVERGENCE_RATE:
                     diverging += 1
                     if diverging >= 2:
-                        return NewtonOutcome(x, False, k, err, f"diverging (rate {rate:.3g} at "
-                                             f"iteration {k} with a fresh Jacobian)", floor), stale
+                        return NewtonOutcome(x, False, k, err, says.diverging(rate, k), floor), stale
                 else:
                     diverging = 0
                 if not full:
@@ -334,8 +329,6 @@ class NewtonSolver:
             else:
                 diverging = 0
         if polish:
-            return NewtonOutcome(x, True, opts.max_iter, err, f"converged in {opts.max_iter} iterations (at the "
-                                 "residual's floor, the correction still halving)", floor), stale
+            return NewtonOutcome(x, True, opts.max_iter, err, says.at_floor(opts.max_iter), floor), stale
         return NewtonOutcome(x, False, opts.max_iter, err,
-                             f"not converged in {opts.max_iter} iterations "
-                             f"(max|r| = {err:.3e}, target {threshold:.3e})", floor), stale
+                             says.not_converged(opts.max_iter, err, threshold), floor), stale

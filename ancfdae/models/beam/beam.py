@@ -41,7 +41,7 @@ __all__ = ["Beam"]
 @functools.cache
 def _finish_residual():
     """The compiled ``f + M a - lambda f_ext`` (imports numba: only reached on the fused path)."""
-    from .assembly_numba import finish_residual
+    from ..._residual_numba import finish_residual
     return finish_residual
 
 

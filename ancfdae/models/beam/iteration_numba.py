@@ -31,7 +31,7 @@ from numba import njit
 from ...integrators._affine import affine3
 from ...integrators._linsolve_numba import band_solve
 from ..._scale import max_abs
-from .assembly_numba import finish_residual
+from ..._residual_numba import finish_residual
 
 __all__ = ["alpha_update", "alpha_finish", "carry_on"]
 

@@ -16,7 +16,7 @@ __all__ = ["StageEvaluator", "potential_gradient_stages"]
 @functools.cache
 def _finish_stages():
     """The compiled ``F + M A - lambda F_ext`` of the stages (imports numba: only reached on the fused path)."""
-    from .assembly_numba import finish_stages
+    from ..._residual_numba import finish_stages
     return finish_stages
 
 

@@ -27,7 +27,7 @@ then the solver's tests in its order -- converged, round-off stagnation (the mat
 the rate against ``contraction`` and twice in a row at least ``divergence_rate`` -- and the same
 status for every way it ends (``CONVERGED_INITIAL`` ... ``MAX_ITER``), which the caller turns into the
 solver's outcome and counters (:mod:`ancfdae._static_compiled`). The residual is ``(f + 0) - lam f_ext``,
-the rounding of ``f + M 0 - lam f_ext`` (:func:`.assembly_numba.finish_residual` with ``a = 0``).
+the rounding of ``f + M 0 - lam f_ext`` (:func:`ancfdae._residual_numba.finish_residual` with ``a = 0``).
 """
 from __future__ import annotations
 
