@@ -7,15 +7,16 @@ is a :class:`ancfdae.System` of one beam whose element offers compiled index-3 s
 compiled set (its :attr:`~ancfdae.System.compiled_arrays`, :mod:`ancfdae.system_compiled`), :class:`Index3Steps`
 runs the steps in one compiled call (contract and decisions in
 :mod:`ancfdae.integrators._index3_steps_numba`): the predictor, the modified-Newton iterations, the refresh
-of the KKT matrix and its dense LU, the update of ``q, v, a, ah, lam`` and the counters. The time functions
+of the KKT matrix and its LU (band storage, in the band order of :attr:`SystemArrays.kkt`), the update of ``q, v, a, ah, lam`` and the counters. The time functions
 (the joints' drives, the rigid bodies' and the beam's loads) are evaluated here, before the call, at the ends
 of the coming steps: one call of each user function per step (a table kept for :data:`TABLE_STEPS` steps),
 not one per iteration.
 
 A step that needs a decision of Python (a failure, the solver's retry) is taken by the ordinary Python step,
-which redoes it from its start with the factors the compiled steps left (a dense factorisation is handed
+which redoes it from its start with the factors the compiled steps left (their band factors are handed
 over as such). The Python path stays the reference: the tests hold states, multipliers and counters equal
-to it on B5 and B6 (the dense LU rounds differently from LAPACK's banded one, so states agree to round-off).
+to it on B5 and B6 (the LU in band order rounds differently from LAPACK's of the System's order, so states agree to
+round-off).
 """
 from __future__ import annotations
 
@@ -37,18 +38,18 @@ STEPS_PER_CALL = 500
 TABLE_STEPS = 256
 
 
-class _DenseLU:
-    """The compiled steps' dense factorisation, handed to the Python solver (``solve`` as its factors')."""
+class _KKTFactors:
+    """The compiled steps' band factors of the KKT matrix (band order), handed to the Python solver (``solve``
+    as its factors')."""
 
-    __slots__ = ("lu", "piv")
+    __slots__ = ("ab", "piv", "kkt")
 
-    def __init__(self, lu, piv):
-        self.lu, self.piv = lu, piv
+    def __init__(self, ab, piv, kkt):
+        self.ab, self.piv, self.kkt = ab, piv, kkt
 
     def solve(self, rhs):
-        x = np.array(rhs, dtype=float)
-        sn.dense_solve(self.lu, self.piv, x)
-        return x
+        rhs = np.ascontiguousarray(rhs, dtype=float)
+        return sn.kkt_solve(self.ab, self.piv, self.kkt, rhs, np.empty(rhs.size))
 
 
 class Index3Steps:
@@ -66,9 +67,9 @@ class Index3Steps:
             s.t0, s.h, s.t_bound, s.beta, s.gamma, s.alpha_m, s.alpha_f, o.tol, o.contraction, GRID_TOL,
             s._mscale, o.xtol, arrays.load_factor, s.FLOOR_ROUNDOFF)
         self._fpar = f
-        N = model.n_dof + model.n_constraints
-        self._LU, self._piv = np.zeros((N, N)), np.zeros(N, dtype=np.int64)
-        self._LUs, self._pivs = np.zeros((N, N)), np.zeros(N, dtype=np.int64)
+        N, (_, kl, ku) = model.n_dof + model.n_constraints, arrays.kkt
+        self._AB, self._piv = np.zeros((N, 2 * kl + ku + 1)), np.zeros(N, dtype=np.int64)
+        self._ABs, self._pivs = np.zeros_like(self._AB), np.zeros(N, dtype=np.int64)
         self._no_band = (np.zeros((1, 1), order="F"), np.zeros(1, dtype=np.int32))   # LAPACK's types
         self._table, self._grid = (0, np.zeros((0, arrays.n_weights)), None), None   # (first step, W, E), grid
 
@@ -113,8 +114,8 @@ class Index3Steps:
         lu = newton._lu
         inner = getattr(lu, "_lu", None)
         kind, lub, bpiv, kl, ku = sn.NONE, *self._no_band, 0, 0
-        if isinstance(inner, _DenseLU) and inner.lu is self._LU:
-            kind = sn.DENSE
+        if isinstance(inner, _KKTFactors) and inner.ab is self._AB:
+            kind = sn.OWN
         elif isinstance(inner, _Banded) and inner.dtype == np.float64:
             kind, lub, bpiv, kl, ku = sn.BAND, inner.lub, inner.piv, inner.kl, inner.ku
         elif lu is not None:
@@ -133,8 +134,8 @@ class Index3Steps:
         S[0], S[1], S[2], S[3], L[0], L[1] = s.q, s.v, s.a, s._ah, s.lam, s.lam
         out = np.zeros(sn.N_OUT, dtype=np.int64)
         a = self._arrays
-        self._fn(S, P, L, f, ipar, out, self._LU, self._piv, self._LUs, self._pivs, lub, bpiv, W, E, a.cons, a.rigid,
-                 a.beam, a.element_args)
+        self._fn(S, P, L, f, ipar, out, self._AB, self._piv, self._ABs, self._pivs, lub, bpiv, W, E, a.cons, a.rigid,
+                 a.beam, a.element_args, a.kkt)
         done, status, iterations, evals, jacs = (int(x) for x in out)
         st = newton.stats
         st.iterations += iterations
@@ -146,11 +147,11 @@ class Index3Steps:
         s.model.n_jacobian += jacs
         s._floor = float(f[sn.FLOOR])
         s._h_matrix = float(f[sn.H_MATRIX]) if ipar[sn.HAVE_H] else None
-        if ipar[sn.KIND] == sn.DENSE and kind != sn.DENSE or ipar[sn.KIND] == sn.NONE:
+        if ipar[sn.KIND] == sn.OWN and kind != sn.OWN or ipar[sn.KIND] == sn.NONE:
             newton._lu = None
-            if ipar[sn.KIND] == sn.DENSE:
+            if ipar[sn.KIND] == sn.OWN:
                 newton._lu = _Factor.__new__(_Factor)
-                newton._lu._lu = _DenseLU(self._LU, self._piv)
+                newton._lu._lu = _KKTFactors(self._AB, self._piv, a.kkt)
         if status == sn.STOPPED and done:   # the last step is the driver's to accept
             s.t, s.q, s.v, s.a, s._ah, s.lam = float(f[sn.T_PREV]), P[0], P[1], P[2], P[3], L[1]
             s.previous = None

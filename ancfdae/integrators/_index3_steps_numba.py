@@ -6,21 +6,27 @@ offers a fused kernel and any number of rigid bodies, every constraint row folde
 (:mod:`ancfdae.joints.assembled_numba`). Per Newton iteration: the substitution with the cached factors, the
 update of ``x = [y, mu]``, the step's states, the beam's fused residual and ``+ M a - lambda f_ext``, the rigid
 bodies' ``M a - f(t, q) - f_g``, ``(g, G^T lam)`` in one pass, the norms and the solver's decisions. A refresh
-assembles the KKT matrix ``[[K + s M + H(lam), sm G^T], [sm G, 0]]`` densely (the beam's tangent from its
-fused kernel, ``H`` and ``G`` on their fixed patterns) and factorises it with partial pivoting
-(:func:`dense_lu`); the round-off floor is the Python path's. The entry point::
+assembles the KKT matrix ``[[K + s M + H(lam), sm G^T], [sm G, 0]]`` (the beam's tangent from its fused kernel,
+``H`` and ``G`` on their fixed patterns) in band storage, its unknowns in the band order of
+:attr:`ancfdae.system_compiled.SystemArrays.kkt` (reverse Cuthill-McKee of its pattern: B6's 62 unknowns have 8 sub-
+and 8 super-diagonals, 57 in the System's order), and factorises it with partial pivoting inside the band
+(:func:`~ancfdae.integrators._linsolve_numba.band_factor`, LAPACK's ``dgbtf2`` elimination); the round-off floor
+is the Python path's. The entry point::
 
-    steps(S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv, W, E, cons, rigid, beam, element_args)
+    steps(S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv, W, E, cons, rigid, beam, element_args, kkt)
 
 * ``S`` (4, n): ``q, v, a, ah`` (``ah`` the algorithmic acceleration) at ``fpar[T]`` on entry, the state
   reached on return; ``P`` (4, n) the state before the last step taken; ``L`` (2, m): the multipliers
   reached and those before the last step.
-* ``LU, piv``: a dense factorisation (written at each refresh), ``LUs, pivs`` its copy at the start of a
-  step that refreshed; ``lub, bpiv``: LAPACK's banded factors the Python path left (``ipar[KIND] = BAND``).
+* ``AB, piv``: the band factors of the KKT matrix in band order (``(n + m, 2 kl + ku + 1)``, the layout of
+  :func:`~ancfdae.integrators._linsolve_numba.band_factor`; written at each refresh, ``ipar[KIND] = OWN``),
+  ``ABs, pivs`` their copy at the start of a step that refreshed; ``lub, bpiv``: LAPACK's banded factors of the
+  matrix in the System's order that the Python path left (``ipar[KIND] = BAND``, its ``KL``, ``KU``).
 * ``W`` (k, nw): per coming step, the time weights at its end (the constraint terms' row 0 of
   :meth:`~ancfdae.joints.assembled.ConstraintSet.weights`, then the rigid bodies' load factors); ``E``
   (k or 1, nb): the beam's external force at each step's end (one row: constant).
-* ``cons``, ``rigid``, ``beam``: the arrays of :class:`ancfdae.integrators._index3_steps.Index3Steps`.
+* ``cons``, ``rigid``, ``beam``, ``kkt``: the arrays of :class:`ancfdae.system_compiled.SystemArrays`
+  (``kkt = (pos, kl, ku)``: unknown ``i`` at row and column ``pos[i]`` of the band-ordered matrix).
 
 Status ``STOPPED`` (the last step reached ``t_stop`` or the end, or ``max_count`` steps were taken) or
 ``NEEDS_PYTHON``: the next step needs a decision of Python (a non-finite value, a failed attempt that the
@@ -34,12 +40,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ancfdae.integrators._linsolve_numba import band_solve
+from ancfdae.integrators._linsolve_numba import band_factor, band_solve
 from ancfdae._scale import max_abs
 from ancfdae.joints.assembled_numba import _g_force, _rates
 from ancfdae.models.beam.assembly_numba import finish_residual
 
-__all__ = ["index3_steps", "system_multipliers", "dense_lu", "dense_solve"]
+__all__ = ["index3_steps", "system_multipliers", "kkt_solve"]
 
 # fpar
 T0, H, T, T_BOUND, T_STOP, H_MATRIX, BETA, GAMMA, ALPHA_M, ALPHA_F, TOL, ATOL, FLOOR, CONTRACTION, GRID_TOL, \
@@ -48,55 +54,33 @@ N_FPAR = 20
 # ipar
 N_STEPS, MAX_COUNT, MAX_ITER, KIND, HAVE_H, KL, KU = range(7)
 N_IPAR = 7
-# ipar[KIND]
-NONE, DENSE, BAND = 0, 1, 2
+# ipar[KIND]: no factors, the steps' own band factors (AB, piv), LAPACK's of the Python path (lub, bpiv)
+NONE, OWN, BAND = 0, 1, 2
 # out
 DONE, STATUS, ITERATIONS, RESIDUALS, JACOBIANS = range(5)
 N_OUT = 5
 STOPPED, NEEDS_PYTHON = 0, 1
 
 
+@njit(inline="always")
+def _put(AB, kv, pos, i, j, val):
+    """``A[i, j] += val`` of the KKT matrix: row and column ``pos[.]`` of the band order, band storage."""
+    pi, pj = pos[i], pos[j]
+    AB[pj, kv + pi - pj] += val
+
+
 @njit(cache=True, error_model="numpy")   # a zero pivot gives inf/nan, as LAPACK does
-def dense_lu(A, piv):
-    """``A = P L U`` in place (row-major Doolittle with partial pivoting, LAPACK's ``getrf`` convention:
-    row ``k`` was swapped with row ``piv[k]``)."""
-    n = A.shape[0]
-    for k in range(n):
-        p, big = k, abs(A[k, k])
-        for i in range(k + 1, n):
-            if abs(A[i, k]) > big:
-                p, big = i, abs(A[i, k])
-        piv[k] = p
-        if p != k:
-            for j in range(n):
-                A[k, j], A[p, j] = A[p, j], A[k, j]
-        d = A[k, k]
-        for i in range(k + 1, n):
-            lik = A[i, k] / d
-            A[i, k] = lik
-            if lik != 0.0:
-                for j in range(k + 1, n):
-                    A[i, j] -= lik * A[k, j]
-
-
-@njit(cache=True, error_model="numpy")
-def dense_solve(LU, piv, b):
-    """Solve ``A x = b`` in place in ``b`` with the factors of :func:`dense_lu`."""
-    n = b.size
-    for k in range(n):
-        p = piv[k]
-        if p != k:
-            b[k], b[p] = b[p], b[k]
-    for i in range(n):
-        s = b[i]
-        for j in range(i):
-            s -= LU[i, j] * b[j]
-        b[i] = s
-    for i in range(n - 1, -1, -1):
-        s = b[i]
-        for j in range(i + 1, n):
-            s -= LU[i, j] * b[j]
-        b[i] = s / LU[i, i]
+def kkt_solve(AB, piv, kkt, r, d):
+    """``d = A^-1 r`` with the band factors ``AB, piv`` of the KKT matrix in band order (``d``: a work array of
+    ``r``'s size, returned); ``r`` is in the System's order, and so is the result."""
+    pos, kl, ku = kkt
+    b = np.empty(r.size)
+    for i in range(r.size):
+        b[pos[i]] = r[i]
+    band_solve(AB.T, kl, ku, piv, b)
+    for i in range(r.size):
+        d[i] = b[pos[i]]
+    return d
 
 
 @njit(cache=True)
@@ -145,29 +129,32 @@ def _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid
 
 
 @njit(inline="always")
-def _matrix(fused, A, x, q, n, m, s, sm, w, cons, rigid, beam, eargs, rbuf, kbuf):
-    """The KKT matrix at ``x`` (state ``q``) into ``A`` (dense); returns ``max(max|K|, max|sm G|)``."""
+def _matrix(fused, AB, x, q, n, m, s, sm, w, cons, rigid, beam, eargs, rbuf, kbuf, kkt):
+    """The KKT matrix at ``x`` (state ``q``) into ``AB`` (band order and storage, ``kkt``); returns
+    ``(max|K|, max|sm G|)``."""
     ob, nb, q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices = beam
     lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa, ls, qslot, g_indptr, g_indices = cons
     ridx, mi, mj, mv, grav, fvec, fcol, ci, cj, cvv, ccol = rigid
-    A[:, :] = 0.0
+    pos, kl, ku = kkt
+    kv = kl + ku
+    AB[:, :] = 0.0
     fused(q[ob:ob + nb], q_fixed, gather, vec_slot, mat_slot, True, rbuf, kbuf, *eargs)
     kmax = 0.0
     for i in range(nb):
         for jj in range(indptr[i], indptr[i + 1]):
-            A[ob + i, ob + indices[jj]] += kbuf[jj] + s * m_data[jj]
+            _put(AB, kv, pos, ob + i, ob + indices[jj], kbuf[jj] + s * m_data[jj])
             kmax = max(kmax, abs(kbuf[jj]))
     for e in range(mi.size):
-        A[mi[e], mj[e]] += s * mv[e]
+        _put(AB, kv, pos, mi[e], mj[e], s * mv[e])
     for e in range(ci.size):
         k = -(w[ccol[e]] * cvv[e])
-        A[ci[e], cj[e]] += k
+        _put(AB, kv, pos, ci[e], cj[e], k)
         kmax = max(kmax, abs(k))
     lam = np.empty(m)
     for i in range(m):
         lam[i] = sm * x[n + i]
     for e in range(qi.size):   # H(lam) = sum_i lam_i A_i
-        A[qj[e], qk[e]] += qa[e] * lam[qi[e]]
+        _put(AB, kv, pos, qj[e], qk[e], qa[e] * lam[qi[e]])
     gdata = np.zeros(g_indices.size)
     for e in range(lt.size):
         gdata[ls[e]] += w[lt[e]] * lv[e]
@@ -177,14 +164,15 @@ def _matrix(fused, A, x, q, n, m, s, sm, w, cons, rigid, beam, eargs, rbuf, kbuf
     for i in range(m):
         for jj in range(g_indptr[i], g_indptr[i + 1]):
             val = sm * gdata[jj]
-            A[n + i, g_indices[jj]] += val
-            A[g_indices[jj], n + i] += val
+            _put(AB, kv, pos, n + i, g_indices[jj], val)
+            _put(AB, kv, pos, g_indices[jj], n + i, val)
             gmax = max(gmax, abs(val))
     return kmax, gmax
 
 
 @njit(inline="always")
-def index3_steps(fused, S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv, W, E, cons, rigid, beam, eargs):
+def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv, W, E, cons, rigid, beam, eargs,
+                 kkt):
     """Index-3 steps until ``t_stop``, the end, ``max_count`` steps or a decision for Python (module docstring)."""
     n, m = S.shape[1], L.shape[1]
     N = n + m
@@ -196,7 +184,6 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv,
     n_steps, max_count, max_iter = ipar[N_STEPS], min(ipar[MAX_COUNT], W.shape[0]), ipar[MAX_ITER]
     kind, kl, ku = ipar[KIND], ipar[KL], ipar[KU]
     have_h, h_matrix, floor = ipar[HAVE_H], fpar[H_MATRIX], fpar[FLOOR]
-    A = np.empty((N, N))
     x, r, dx = np.empty(N), np.empty(N), np.empty(N)
     rbuf, kbuf = np.empty(nb + 1), np.empty(beam[6].size + 1)
     qp, vp, ca = np.empty(n), np.empty(n), np.empty(n)
@@ -240,21 +227,20 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv,
             while not converged and k < max_iter:
                 k += 1
                 if kind == NONE:
-                    if kind0 == DENSE and not saved:   # kept to restore if Python must redo the step
-                        LUs[:, :] = LU
+                    if kind0 == OWN and not saved:   # kept to restore if Python must redo the step
+                        ABs[:, :] = AB
                         pivs[:] = piv
                         saved = True
-                    kmax, gmax = _matrix(fused, A, x, q, n, m, s, sm, w, cons, rigid, beam, eargs, rbuf, kbuf)
+                    kmax, gmax = _matrix(fused, AB, x, q, n, m, s, sm, w, cons, rigid, beam, eargs, rbuf, kbuf, kkt)
                     qm = max(1.0, max_abs(q))
                     floor = max(floor, max(ffac * eps * kmax * qm, ffac * eps * gmax * qm))
-                    LU[:, :] = A
-                    dense_lu(LU, piv)
-                    kind, fresh, jc = DENSE, True, jc + 1
+                    band_factor(AB, kkt[1], kkt[2], piv)
+                    kind, fresh, jc = OWN, True, jc + 1
                     threshold = max(rel, floor)
-                dx[:] = r
-                if kind == DENSE:
-                    dense_solve(LU, piv, dx)
+                if kind == OWN:
+                    kkt_solve(AB, piv, kkt, r, dx)
                 else:
+                    dx[:] = r
                     band_solve(lub, kl, ku, bpiv, dx)
                 its += 1
                 dx_max = max_abs(dx)
@@ -295,7 +281,7 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv,
                     ok = False
         if not ok:   # Python redoes this step from its start: its state, factors and floor as they were
             if saved:
-                LU[:, :] = LUs
+                AB[:, :] = ABs
                 piv[:] = pivs
             kind, floor, have_h, h_matrix = kind0, floor0, have_h0, h_matrix0
             break
@@ -326,10 +312,11 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv,
 
 
 @njit(inline="always")
-def system_multipliers(fused, W, ext, q, v, a_out, lam_out, cons, rigid, beam, eargs, lf):
+def system_multipliers(fused, W, ext, q, v, a_out, lam_out, cons, rigid, beam, eargs, lf, kkt):
     """``(a, lam)`` from ``[[M, G^T], [G, 0]] [a; lam] = [-r(t, q, v, 0); gamma]`` (:func:`ancfdae.constrained.multipliers`)
     into ``a_out``, ``lam_out``: ``W`` (3, nw) the time weights at ``t`` and their derivatives, ``ext`` the beam's
-    external force at ``t``, ``lf`` its load factor; a singular matrix gives non-finite values."""
+    external force at ``t``, ``lf`` its load factor; the matrix in the band order ``kkt`` (its pattern is in the
+    steps' KKT pattern); a singular matrix gives non-finite values."""
     n, m = q.size, lam_out.size
     N = n + m
     ob, nb, q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices = beam
@@ -344,12 +331,14 @@ def system_multipliers(fused, W, ext, q, v, a_out, lam_out, cons, rigid, beam, e
         r[ob + i] = rbuf[i]
     gt, gamma = np.empty(m), np.empty(m)
     _rates(W[1], W[2], lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa, q, v, gt, gamma)
-    A, rhs = np.zeros((N, N)), np.empty(N)
+    pos, kl, ku = kkt
+    kv = kl + ku
+    AB, rhs = np.zeros((N, 2 * kl + ku + 1)), np.empty(N)
     for i in range(nb):
         for jj in range(indptr[i], indptr[i + 1]):
-            A[ob + i, ob + indices[jj]] += m_data[jj]
+            _put(AB, kv, pos, ob + i, ob + indices[jj], m_data[jj])
     for e in range(mi.size):
-        A[mi[e], mj[e]] += mv[e]
+        _put(AB, kv, pos, mi[e], mj[e], mv[e])
     gdata = np.zeros(g_indices.size)
     for e in range(lt.size):
         gdata[ls[e]] += W[0, lt[e]] * lv[e]
@@ -357,16 +346,16 @@ def system_multipliers(fused, W, ext, q, v, a_out, lam_out, cons, rigid, beam, e
         gdata[qslot[e]] += qa[e] * q[qk[e]]
     for i in range(m):
         for jj in range(g_indptr[i], g_indptr[i + 1]):
-            A[n + i, g_indices[jj]] += gdata[jj]
-            A[g_indices[jj], n + i] += gdata[jj]
+            _put(AB, kv, pos, n + i, g_indices[jj], gdata[jj])
+            _put(AB, kv, pos, g_indices[jj], n + i, gdata[jj])
     for i in range(n):
         rhs[i] = -r[i]
     for i in range(m):
         rhs[n + i] = gamma[i]
     piv = np.empty(N, dtype=np.int64)
-    dense_lu(A, piv)
-    dense_solve(A, piv, rhs)
+    band_factor(AB, kl, ku, piv)
+    x = kkt_solve(AB, piv, kkt, rhs, np.empty(N))
     for i in range(n):
-        a_out[i] = rhs[i]
+        a_out[i] = x[i]
     for i in range(m):
-        lam_out[i] = rhs[n + i]
+        lam_out[i] = x[n + i]
