@@ -51,12 +51,13 @@ def _iterations(reps, AB, piv, x, q, w, ext, cons, rigid, beam, eargs, kkt, solv
     n, m = q.size, x.size - q.size
     rbuf, kbuf = np.empty(beam[1] + 1), np.empty(beam[6].size + 1)
     r, d, zero = np.empty(n + m), np.empty(n + m), np.zeros(n)
+    work = (np.empty(n), np.empty(n), np.empty(n), np.empty(m), np.empty(m), np.empty(n), np.empty(n), np.empty(n))
     for _ in range(reps):
         if solve:
-            sn.kkt_solve(AB, piv, kkt, x, d)
+            sn.kkt_solve(AB, piv, kkt, x, d, r)
         else:
             sn._residual(be2d_fused, x, r, n, m, q, zero, zero, 1.0, 1e8, 1e6, w, ext, 1.0, cons, rigid, beam, eargs,
-                         rbuf, kbuf)
+                         rbuf, kbuf, work)
 
 
 def _best(f, *args):

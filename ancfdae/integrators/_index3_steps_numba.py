@@ -13,7 +13,8 @@ and 8 super-diagonals, 57 in the System's order), and factorises it with partial
 (:func:`~ancfdae.integrators._linsolve_numba.band_factor`, LAPACK's ``dgbtf2`` elimination); the round-off floor
 is the Python path's. The entry point::
 
-    steps(S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv, W, E, cons, rigid, beam, element_args, kkt)
+    steps(S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv, W, E, cons, rigid, beam, element_args, kkt,
+          T_rec, rec_q, rec_v, rec_a, rec_lam)
 
 * ``S`` (4, n): ``q, v, a, ah`` (``ah`` the algorithmic acceleration) at ``fpar[T]`` on entry, the state
   reached on return; ``P`` (4, n) the state before the last step taken; ``L`` (2, m): the multipliers
@@ -22,11 +23,17 @@ is the Python path's. The entry point::
   :func:`~ancfdae.integrators._linsolve_numba.band_factor`; written at each refresh, ``ipar[KIND] = OWN``),
   ``ABs, pivs`` their copy at the start of a step that refreshed; ``lub, bpiv``: LAPACK's banded factors of the
   matrix in the System's order that the Python path left (``ipar[KIND] = BAND``, its ``KL``, ``KU``).
-* ``W`` (k, nw): per coming step, the time weights at its end (the constraint terms' row 0 of
-  :meth:`~ancfdae.joints.assembled.ConstraintSet.weights`, then the rigid bodies' load factors); ``E``
+* ``W`` (k, 3, nw): per coming step, the time weights at its end and their first two derivatives (the constraint
+  terms' :meth:`~ancfdae.joints.assembled.ConstraintSet.weights`, then the rigid bodies' load factors); ``E``
   (k or 1, nb): the beam's external force at each step's end (one row: constant).
 * ``cons``, ``rigid``, ``beam``, ``kkt``: the arrays of :class:`ancfdae.system_compiled.SystemArrays`
   (``kkt = (pos, kl, ku)``: unknown ``i`` at row and column ``pos[i]`` of the band-ordered matrix).
+
+* ``T_rec``: the coming output times (ascending, those after ``t_stop`` ignored). A step accepted here whose end is one
+  of them (to ``GRID_TOL``) is recorded: ``q, v, a`` into row ``out[RECORDED]`` of ``rec_q, rec_v, rec_a`` and the
+  multipliers of :func:`system_multipliers` (the driver's, :func:`ancfdae.constrained.multipliers`) into ``rec_lam``;
+  a step that passes one inside (the driver interpolates) or whose multipliers are not finite (the driver's solve
+  raises) stops the call, handed to the driver like the last one.
 
 Status ``STOPPED`` (the last step reached ``t_stop`` or the end, or ``max_count`` steps were taken) or
 ``NEEDS_PYTHON``: the next step needs a decision of Python (a non-finite value, a failed attempt that the
@@ -57,8 +64,8 @@ N_IPAR = 7
 # ipar[KIND]: no factors, the steps' own band factors (AB, piv), LAPACK's of the Python path (lub, bpiv)
 NONE, OWN, BAND = 0, 1, 2
 # out
-DONE, STATUS, ITERATIONS, RESIDUALS, JACOBIANS = range(5)
-N_OUT = 5
+DONE, STATUS, ITERATIONS, RESIDUALS, JACOBIANS, RECORDED = range(6)
+N_OUT = 6
 STOPPED, NEEDS_PYTHON = 0, 1
 
 
@@ -70,11 +77,10 @@ def _put(AB, kv, pos, i, j, val):
 
 
 @njit(cache=True, error_model="numpy")   # a zero pivot gives inf/nan, as LAPACK does
-def kkt_solve(AB, piv, kkt, r, d):
-    """``d = A^-1 r`` with the band factors ``AB, piv`` of the KKT matrix in band order (``d``: a work array of
-    ``r``'s size, returned); ``r`` is in the System's order, and so is the result."""
+def kkt_solve(AB, piv, kkt, r, d, b):
+    """``d = A^-1 r`` with the band factors ``AB, piv`` of the KKT matrix in band order (``d`` returned, ``b`` a
+    work array, both of ``r``'s size); ``r`` is in the System's order, and so is the result."""
     pos, kl, ku = kkt
-    b = np.empty(r.size)
     for i in range(r.size):
         b[pos[i]] = r[i]
     band_solve(AB.T, kl, ku, piv, b)
@@ -84,11 +90,12 @@ def kkt_solve(AB, piv, kkt, r, d):
 
 
 @njit(cache=True)
-def _rigid_residual(r, q, a, w, rigid):
-    """``r_i = (M a)_i - f_i(t, q) - f_g,i`` on the rigid bodies' coordinates (``RigidBody.residual``)."""
+def _rigid_residual(r, q, a, w, rigid, f, ma):
+    """``r_i = (M a)_i - f_i(t, q) - f_g,i`` on the rigid bodies' coordinates (``RigidBody.residual``); ``f``,
+    ``ma``: work arrays of ``r``'s size."""
     ridx, mi, mj, mv, grav, fvec, fcol, ci, cj, cv, ccol = rigid
-    f = np.zeros(r.size)
-    ma = np.zeros(r.size)
+    f[:] = 0.0
+    ma[:] = 0.0
     for k in range(fcol.size):
         s = w[fcol[k]]
         for i in ridx:
@@ -102,10 +109,11 @@ def _rigid_residual(r, q, a, w, rigid):
 
 
 @njit(inline="always")
-def _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid, beam, eargs, rbuf, kbuf):
-    """The step's residual ``[r(t1, q1, v1, a1) + G^T lam; sm g]`` at ``x`` into ``r``; returns ``(max|r|, q1)``."""
+def _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid, beam, eargs, rbuf, kbuf, work):
+    """The step's residual ``[r(t1, q1, v1, a1) + G^T lam; sm g]`` at ``x`` into ``r``; returns ``(max|r|, q1)``
+    (``q1`` in the work arrays ``work = (q, v, a, lam, g, f, f2, ma)``, overwritten by the next call)."""
     ob, nb, q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices = beam
-    q, v, a, lam = np.empty(n), np.empty(n), np.empty(n), np.empty(m)
+    q, v, a, lam, g, f, f2, ma = work
     for i in range(n):
         y = x[i]
         q[i] = qp[i] + y
@@ -115,10 +123,9 @@ def _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid
         lam[i] = sm * x[n + i]
     fused(q[ob:ob + nb], q_fixed, gather, vec_slot, mat_slot, False, rbuf, kbuf, *eargs)
     finish_residual(rbuf, m_data, indptr, indices, a[ob:ob + nb], lf, ext)
-    _rigid_residual(r, q, a, w, rigid)
+    _rigid_residual(r, q, a, w, rigid, f2, ma)
     for i in range(nb):
         r[ob + i] = rbuf[i]
-    g, f = np.empty(m), np.empty(n)
     lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa = cons[:11]
     _g_force(w, lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa, q, lam, g, f)
     for i in range(n):
@@ -172,7 +179,7 @@ def _matrix(fused, AB, x, q, n, m, s, sm, w, cons, rigid, beam, eargs, rbuf, kbu
 
 @njit(inline="always")
 def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv, W, E, cons, rigid, beam, eargs,
-                 kkt):
+                 kkt, T_rec, rec_q, rec_v, rec_a, rec_lam):
     """Index-3 steps until ``t_stop``, the end, ``max_count`` steps or a decision for Python (module docstring)."""
     n, m = S.shape[1], L.shape[1]
     N = n + m
@@ -184,11 +191,13 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv,
     n_steps, max_count, max_iter = ipar[N_STEPS], min(ipar[MAX_COUNT], W.shape[0]), ipar[MAX_ITER]
     kind, kl, ku = ipar[KIND], ipar[KL], ipar[KU]
     have_h, h_matrix, floor = ipar[HAVE_H], fpar[H_MATRIX], fpar[FLOOR]
-    x, r, dx = np.empty(N), np.empty(N), np.empty(N)
+    x, r, dx, bx = np.empty(N), np.empty(N), np.empty(N), np.empty(N)
     rbuf, kbuf = np.empty(nb + 1), np.empty(beam[6].size + 1)
     qp, vp, ca = np.empty(n), np.empty(n), np.empty(n)
+    work = (np.empty(n), np.empty(n), np.empty(n), np.empty(m), np.empty(m), np.empty(n), np.empty(n), np.empty(n))
     t = fpar[T]
-    done, iters, evals, jacs, status = 0, 0, 0, 0, NEEDS_PYTHON
+    done, iters, evals, jacs, status, nrec = 0, 0, 0, 0, NEEDS_PYTHON, 0
+    a_scratch = np.empty(n)
     eps = np.finfo(np.float64).eps
     while done < max_count:
         t_new = t0 + (n_steps + done + 1) * h
@@ -200,8 +209,9 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv,
         if have_h == 0 or abs(hs - h_matrix) > 1e-8 * h:
             kind, have_h, h_matrix = NONE, 1, hs
         # index3_equations
-        w = W[done]
+        w = W[done, 0]
         ext = E[done] if E.shape[0] > 1 else E[0]
+        wi = done
         s = (1.0 - am) / ((1.0 - af) * beta * hs * hs)
         sm = s * mscale
         c_v = gamma / (beta * hs)
@@ -216,7 +226,7 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv,
             x[n + i] = L[0, i] / sm
         # NewtonSolver.solve and _attempt (modified Newton)
         err, q = _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid, beam, eargs,
-                           rbuf, kbuf)
+                           rbuf, kbuf, work)
         its, ev, jc, saved = 0, 1, 0, False
         ok = np.isfinite(err)
         if ok:
@@ -238,7 +248,7 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv,
                     kind, fresh, jc = OWN, True, jc + 1
                     threshold = max(rel, floor)
                 if kind == OWN:
-                    kkt_solve(AB, piv, kkt, r, dx)
+                    kkt_solve(AB, piv, kkt, r, dx, bx)
                 else:
                     dx[:] = r
                     band_solve(lub, kl, ku, bpiv, dx)
@@ -250,7 +260,7 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv,
                 for i in range(N):
                     x[i] = x[i] - dx[i]
                 err_new, q = _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid, beam,
-                                       eargs, rbuf, kbuf)
+                                       eargs, rbuf, kbuf, work)
                 ev += 1
                 if not np.isfinite(err_new):
                     ok = False
@@ -301,14 +311,28 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv,
         done += 1
         t_prev, t = t, t_new
         fpar[T_PREV], fpar[T] = t_prev, t
-        if t >= t_bound or t_stop <= t + grid_tol * (t - t_prev):
+        tol_t = grid_tol * (t - t_prev)
+        if t >= t_bound or t_stop <= t + tol_t or done == max_count:
             status = STOPPED
             break
-    if done == max_count:
-        status = STOPPED
+        if nrec < rec_q.shape[0] and T_rec[nrec] <= t + tol_t:   # an output time reached (the driver's test)
+            if abs(T_rec[nrec] - t) > tol_t:   # inside the step: the driver interpolates
+                status = STOPPED
+                break
+            system_multipliers(fused, W[wi], ext, S[0], S[1], a_scratch, rec_lam[nrec], cons, rigid, beam, eargs, lf,
+                               kkt)
+            if not np.isfinite(max_abs(rec_lam[nrec])):   # the driver's solve reports it
+                status = STOPPED
+                break
+            T_rec[nrec] = t   # the step's time, as the driver records it
+            rec_q[nrec, :] = S[0]
+            rec_v[nrec, :] = S[1]
+            rec_a[nrec, :] = S[2]
+            nrec += 1
     fpar[FLOOR], fpar[H_MATRIX] = floor, h_matrix
     ipar[KIND], ipar[HAVE_H] = kind, have_h
-    out[DONE], out[STATUS], out[ITERATIONS], out[RESIDUALS], out[JACOBIANS] = done, status, iters, evals, jacs
+    out[DONE], out[STATUS], out[ITERATIONS], out[RESIDUALS], out[JACOBIANS], out[RECORDED] = (done, status, iters,
+                                                                                           evals, jacs, nrec)
 
 
 @njit(inline="always")
@@ -326,7 +350,7 @@ def system_multipliers(fused, W, ext, q, v, a_out, lam_out, cons, rigid, beam, e
     rbuf, kbuf = np.empty(nb + 1), np.empty(1)
     fused(q[ob:ob + nb], q_fixed, gather, vec_slot, mat_slot, False, rbuf, kbuf, *eargs)
     finish_residual(rbuf, m_data, indptr, indices, zero[ob:ob + nb], lf, ext)
-    _rigid_residual(r, q, zero, W[0], rigid)
+    _rigid_residual(r, q, zero, W[0], rigid, np.empty(n), np.empty(n))
     for i in range(nb):
         r[ob + i] = rbuf[i]
     gt, gamma = np.empty(m), np.empty(m)
@@ -354,7 +378,7 @@ def system_multipliers(fused, W, ext, q, v, a_out, lam_out, cons, rigid, beam, e
         rhs[n + i] = gamma[i]
     piv = np.empty(N, dtype=np.int64)
     band_factor(AB, kl, ku, piv)
-    x = kkt_solve(AB, piv, kkt, rhs, np.empty(N))
+    x = kkt_solve(AB, piv, kkt, rhs, np.empty(N), np.empty(N))
     for i in range(n):
         a_out[i] = x[i]
     for i in range(m):

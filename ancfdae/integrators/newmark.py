@@ -198,13 +198,28 @@ class _AlphaFamily(NewtonStepper):
         """
         steps = self._compiled_steps()
         if self._constrained:
-            return steps.run(float(t_stop), int(max_count)) if steps is not None and max_count >= 1 else (self.step(), 0)
+            return steps.run(float(t_stop), int(max_count))[:2] if steps is not None and max_count >= 1 else (self.step(), 0)
         lu = self.newton._lu
         band = getattr(lu, "_lu", None)
         if (steps is None or max_count < 1 or self._h_matrix is None or getattr(band, "lub", None) is None
                 or not band._compiled or band.dtype != np.float64):
             return self.step(), 0
         return steps.run(band, float(t_stop), int(max_count))
+
+    def steps_sampling(self, t_out: np.ndarray, t_end: float, max_count: int):
+        """:meth:`steps_until` across several output times: ``(outcome, taken, samples)``.
+
+        On a System with compiled index-3 steps (:mod:`ancfdae.integrators._index3_steps`) one compiled call takes
+        the steps up to the last of the coming output times ``t_out`` (or ``t_end``) that it can, and records the
+        state and the reactions at each output time an accepted step ends on: ``samples = (t, q, v, a, lam)``
+        (rows), what the driver would record there. Otherwise ``samples`` is None and this is :meth:`steps_until`
+        up to ``t_out[0]``.
+        """
+        steps = self._compiled_steps() if self._constrained else None
+        t_stop = float(t_out[-1]) if len(t_out) else float(t_end)
+        if steps is None or max_count < 1:
+            return (*self.steps_until(float(t_out[0]) if len(t_out) else float(t_end), max_count), None)
+        return steps.run(t_stop, int(max_count), t_out)
 
     def _compiled_steps(self):
         """The model's compiled steps for this run (:class:`._alpha_steps.AlphaSteps`; constrained:

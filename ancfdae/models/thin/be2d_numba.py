@@ -259,11 +259,11 @@ def be2d_static_newton(x, r, f_ext, fpar, ipar, flat, ab, piv, kdata, rbuf, arra
 
 @njit(cache=True)
 def be2d_index3_steps(S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv, W, E, cons, rigid, beam, element_args,
-                      kkt):
+                      kkt, T_rec, rec_q, rec_v, rec_a, rec_lam):
     """Index-3 steps of a System holding a BE2D beam in one call (contract in
     :mod:`ancfdae.integrators._index3_steps_numba`)."""
     index3_steps(be2d_fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv, W, E, cons, rigid, beam,
-                 element_args, kkt)
+                 element_args, kkt, T_rec, rec_q, rec_v, rec_a, rec_lam)
 
 
 @njit(cache=True)
