@@ -135,3 +135,15 @@ def test_bad_drive_named_from_the_table():
     rows = System([beam], [bad]).compiled_rows
     with pytest.raises(ValueError, match=r"`angle`\(t\) must return three finite arrays.*t = 0.2"):
         rows.weight_table(np.array([0.0, 0.2]))
+
+
+def test_constrained_runs_take_the_index3_threshold():
+    # catches: the index-3 refresh threshold not applied on a System, applied to a beam alone, or over the user's
+    from ancfdae.integrators._newton_records import CONTRACTION
+    from ancfdae.integrators.newmark import INDEX3_CONTRACTION
+    b = slider_crank("BE2D", 4)
+    run = lambda model, **nw: simulate(model, (0.0, 1e-3), "generalized-alpha", h=1e-4, newton=nw).options["newton"]
+    assert run(b.system)["contraction"] == INDEX3_CONTRACTION != CONTRACTION
+    assert run(b.system, contraction=0.2)["contraction"] == 0.2
+    beam = Beam(BE2D(Material(2.0e9, 0.3, 1200.0), RectangularSection(0.02)), 2, 0.5)
+    assert run(beam)["contraction"] == CONTRACTION
