@@ -206,7 +206,7 @@ class _AlphaFamily(NewtonStepper):
             return self.step(), 0
         return steps.run(band, float(t_stop), int(max_count))
 
-    def steps_sampling(self, t_out: np.ndarray, t_end: float, max_count: int):
+    def steps_sampling(self, t_out: np.ndarray, t_end: float, max_count: int) -> tuple[StepOutcome, int, tuple | None]:
         """:meth:`steps_until` across several output times: ``(outcome, taken, samples)``.
 
         On a System with compiled index-3 steps (:mod:`ancfdae.integrators._index3_steps`) one compiled call takes
