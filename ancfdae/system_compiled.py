@@ -8,7 +8,13 @@ number of rigid bodies, with every constraint row in the one compiled set (:attr
   quadratic entries, their slots in ``G``'s pattern, that pattern);
 * ``rigid``: the rigid bodies' coordinates, mass entries, gravity, timed forces and timed moment matrices
   (:meth:`ancfdae.bodies.rigid.RigidBody.residual_parts`) on the system's coordinates;
-* ``beam``: the beam's offset, size and fused-kernel arrays (:func:`ancfdae.models.beam.compiled.compiled_residual`).
+* ``beam``: the beam's offset, size and fused-kernel arrays (:func:`ancfdae.models.beam.compiled.compiled_residual`);
+* ``kkt``: the band order of the KKT matrix ``[[K + s M + H, G^T], [G, 0]]`` (its pattern from the arrays above):
+  ``(pos, kl, ku)``, unknown ``i`` at ``pos[i]``, ``kl``/``ku`` its sub- and super-diagonals in that order.
+  The System's order puts the multipliers after every coordinate (B6: 57 sub-diagonals of 62 unknowns); reverse
+  Cuthill-McKee of the symmetric pattern puts each next to its coordinates (B6: 8 and 8, B5: 9 and 9 of 39), and
+  the compiled loops factorise in band storage: fill and LU of B6's matrix 11 us where the dense LU took ~50 us
+  (``python -m benchmarks.index3_cost``).
 
 The time functions stay Python: :meth:`SystemArrays.weights` tabulates them at given times (the rows' weights,
 :meth:`~ancfdae.joints.assembled.ConstraintSet.weight_table`, then one column per rigid-body load) and
@@ -20,13 +26,15 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 from ancfdae._scale import max_abs
 
 __all__ = ["SystemArrays"]
 
-#: the compiled paths factorise the KKT matrix densely: offered up to this many unknowns ``n + m`` (B6's 62: LU
-#: 59 us, a solve 4.4 us, ``python -m benchmarks.index3_cost``; the LU grows as N^3, a banded one would be next)
+#: the compiled paths hold the KKT matrix in band storage of ``n + m`` rows: offered up to this many unknowns
+#: (a band that fills the matrix costs N^3, as a dense LU)
 DENSE_MAX = 200
 
 
@@ -101,6 +109,23 @@ class SystemArrays:
         self._dead = bool(compiled.dead_times)
         self._E = np.ascontiguousarray(compiled.external(0.0)[None, :], dtype=float)
         self._last = (np.zeros(0), np.zeros((0, 3, self.n_weights)))
+        self.kkt = self._band_order(n, rows.m)
+
+    def _band_order(self, n: int, m: int) -> tuple:
+        """``(pos, kl, ku)`` of the KKT matrix's pattern (module docstring): every entry the compiled fill writes."""
+        ob, nb, indptr, indices = self.beam[0], self.beam[1], self.beam[7], self.beam[8]
+        ridx, mi, mj, mv, grav, fvec, fcol, ci, cj = self.rigid[:9]
+        qi, qj, qk = self.cons[7:10]
+        g_indptr, g_indices = self.cons[13], self.cons[14]
+        g_rows = n + np.repeat(np.arange(m), np.diff(g_indptr))
+        rows = np.concatenate((ob + np.repeat(np.arange(nb), np.diff(indptr)), mi, ci, qj, g_rows, g_indices))
+        cols = np.concatenate((ob + indices, mj, cj, qk, g_indices, g_rows))
+        N = n + m
+        pattern = sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(N, N))
+        pos = np.empty(N, dtype=np.int64)
+        pos[reverse_cuthill_mckee(pattern, symmetric_mode=True)] = np.arange(N)
+        off = pos[rows] - pos[cols]
+        return pos, int(max(off.max(initial=0), 0)), int(max(-off.min(initial=0), 0))
 
     @property
     def load_factor(self) -> float:
@@ -173,7 +198,7 @@ class SystemArrays:
         a, lam = np.empty(n), np.empty(m)
         self.compiled.multipliers(W, self.external(np.array([float(t)]))[0], np.ascontiguousarray(q, dtype=float),
                                   np.ascontiguousarray(v, dtype=float), a, lam, self.cons, self.rigid, self.beam,
-                                  self.element_args, self.load_factor)
+                                  self.element_args, self.load_factor, self.kkt)
         if not (math.isfinite(max_abs(a)) and math.isfinite(max_abs(lam))):
             raise np.linalg.LinAlgError(f"multipliers at t = {t:g}: the KKT solve gave non-finite values (singular "
                                         "matrix? are constraints redundant (see ancfdae.constrained.dependent_rows)?)")

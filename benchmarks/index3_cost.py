@@ -1,13 +1,15 @@
 """Where the compiled index-3 steps of B5 and B6 spend their time (no peer).
 
-``python -m benchmarks.index3_cost [--cases b5 b6] [--repeats 3]``
+``python -m benchmarks.index3_cost [--cases b5 b6] [--repeats 3] [--contraction 0.3 0.03] [--t-end-b6 0.5]``
 
-Per case and step (generalized-alpha rho_inf 0.9, Newton rtol 1e-8, as ``benchmarks.multibody_vs_exudyn``, on
-``[0, t_end]``): Newton iterations and matrix refreshes per step, the CPU per step of a run that outputs only at the
-end (the compiled steps, ``ancfdae.integrators._index3_steps``) and the CPU each output time adds (the run with the
-benchmark's output period minus that one, per output: the driver, the tables, the reactions); then the dense LU and
-one solve of the KKT matrix's size (``ancfdae.integrators._index3_steps_numba``). Process-CPU medians of
-``--repeats`` interleaved runs.
+Per case, step and refresh threshold (generalized-alpha rho_inf 0.9, Newton rtol 1e-8, as
+``benchmarks.multibody_vs_exudyn``, on ``[0, t_end]``; ``--contraction``: modified Newton's refresh thresholds to
+compare, interleaved): Newton iterations and matrix refreshes per step, the CPU per step of a run that outputs only
+at the end (the compiled steps, ``ancfdae.integrators._index3_steps``) and the CPU each output time adds (the run
+with the benchmark's output period minus that one, per output: the driver, the tables, the reactions); then the
+pieces of one iteration and of one refresh as compiled calls on a state of the run (the residual, the solve with the
+band factors, the KKT fill with the beam's tangent, the fill and the band LU; ``SystemArrays.kkt``). Process-CPU
+medians of ``--repeats`` interleaved runs; the pieces: best of 7 rounds of 2000 calls.
 """
 from __future__ import annotations
 
@@ -15,68 +17,112 @@ import argparse
 import time
 
 import numpy as np
+from numba import njit
 
 from ancfdae import simulate
-from ancfdae.integrators._index3_steps_numba import dense_lu, dense_solve
+from ancfdae.integrators import _index3_steps_numba as sn
+from ancfdae.integrators._linsolve_numba import band_factor
+from ancfdae.models.thin.be2d_numba import be2d_fused
 from ancfdae.studies._multibody_models import slider_crank, spinup
 
 CASES = {"b5": dict(t_end=5.0, dt_out=0.02, steps=(2e-2, 1e-2, 5e-3, 2.5e-3)),
          "b6": dict(t_end=0.1, dt_out=1e-3, steps=(2e-4, 1e-4, 5e-5))}
 
 
-def _run(system, h, t_end, t_eval):
+def _run(system, h, t_end, t_eval, contraction):
     c0 = time.process_time()
-    res = simulate(system, (0.0, t_end), "generalized-alpha", h=h, rho_inf=0.9, t_eval=t_eval, newton={"tol": 1e-8})
+    res = simulate(system, (0.0, t_end), "generalized-alpha", h=h, rho_inf=0.9, t_eval=t_eval,
+                   newton={"tol": 1e-8, "contraction": contraction})
     return time.process_time() - c0, res
 
 
-def _dense(N, repeats=200):
-    rng = np.random.default_rng(0)
-    A = rng.random((N, N)) + N * np.eye(N)
-    piv = np.zeros(N, dtype=np.int64)
-    LU = A.copy()
-    dense_lu(LU, piv)
-    b = rng.random(N)
-    dense_solve(LU, piv, b.copy())
-    c0 = time.process_time()
-    for _ in range(repeats):
-        LU[:] = A
-        dense_lu(LU, piv)
-    t_lu = (time.process_time() - c0) / repeats
-    c0 = time.process_time()
-    for _ in range(20 * repeats):
-        dense_solve(LU, piv, b.copy())
-    return t_lu, (time.process_time() - c0) / (20 * repeats)
+@njit
+def _fills(reps, AB, piv, x, q, w, cons, rigid, beam, eargs, kkt, factor):
+    rbuf, kbuf = np.empty(beam[1] + 1), np.empty(beam[6].size + 1)
+    for _ in range(reps):
+        sn._matrix(be2d_fused, AB, x, q, q.size, x.size - q.size, 1e8, 1e6, w, cons, rigid, beam, eargs, rbuf,
+                   kbuf, kkt)
+        if factor:
+            band_factor(AB, kkt[1], kkt[2], piv)
+
+
+@njit
+def _iterations(reps, AB, piv, x, q, w, ext, cons, rigid, beam, eargs, kkt, solve):
+    n, m = q.size, x.size - q.size
+    rbuf, kbuf = np.empty(beam[1] + 1), np.empty(beam[6].size + 1)
+    r, d, zero = np.empty(n + m), np.empty(n + m), np.zeros(n)
+    work = (np.empty(n), np.empty(n), np.empty(n), np.empty(m), np.empty(m), np.empty(n), np.empty(n), np.empty(n))
+    for _ in range(reps):
+        if solve:
+            sn.kkt_solve(AB, piv, kkt, x, d, r)
+        else:
+            sn._residual(be2d_fused, x, r, n, m, q, zero, zero, 1.0, 1e8, 1e6, w, ext, 1.0, cons, rigid, beam, eargs,
+                         rbuf, kbuf, work)
+
+
+def _best(f, *args):
+    f(2, *args)
+    best = np.inf
+    for _ in range(7):
+        c0 = time.process_time()
+        f(2000, *args)
+        best = min(best, (time.process_time() - c0) / 2000)
+    return best * 1e6
+
+
+def _pieces(system, res):
+    """Microseconds of: the residual, the solve, the KKT fill, the fill and the band LU (compiled, at the run's end)."""
+    a = system.compiled_arrays
+    n, m = system.n_dof, system.n_constraints
+    q, lam, t = np.asarray(res.q)[-1].copy(), np.asarray(res.lam)[-1], float(res.t[-1])
+    w, ext = a.weights(np.array([t]))[0], a.external(np.array([t]))[0]
+    kl, ku = a.kkt[1:]
+    AB, piv = np.zeros((n + m, 2 * kl + ku + 1)), np.zeros(n + m, dtype=np.int64)
+    x = np.concatenate([np.zeros(n), lam / 1e6])
+    common = (AB, piv, x, q, w)
+    fill = _best(_fills, *common, a.cons, a.rigid, a.beam, a.element_args, a.kkt, False)
+    lu = _best(_fills, *common, a.cons, a.rigid, a.beam, a.element_args, a.kkt, True)
+    resid = _best(_iterations, *common, ext, a.cons, a.rigid, a.beam, a.element_args, a.kkt, False)
+    solve = _best(_iterations, *common, ext, a.cons, a.rigid, a.beam, a.element_args, a.kkt, True)
+    return resid, solve, fill, lu, kl, ku
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cases", nargs="+", choices=tuple(CASES), default=list(CASES))
     ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--contraction", nargs="+", type=float, default=[None],
+                    help="refresh thresholds to compare (default: the method's own)")
+    ap.add_argument("--t-end-b6", type=float, default=CASES["b6"]["t_end"])
     a = ap.parse_args(argv)
     for case in a.cases:
         c = CASES[case]
         system = (spinup("BE2D", 8, w_s=4.0) if case == "b5" else slider_crank("BE2D", 8)).system
-        t_end = c["t_end"]
+        t_end = a.t_end_b6 if case == "b6" else c["t_end"]
         every = np.linspace(0.0, t_end, int(round(t_end / c["dt_out"])) + 1)
-        _run(system, c["steps"][0], min(t_end, 20 * c["steps"][0]), [0.0, min(t_end, 20 * c["steps"][0])])  # JIT
+        _, res = _run(system, c["steps"][0], min(t_end, 20 * c["steps"][0]), [0.0, min(t_end, 20 * c["steps"][0])],
+                      a.contraction[0])   # JIT
         print(f"\n== {case.upper()}, [0, {t_end:g}] s, output every {c['dt_out']:g} s ({every.size - 1} outputs), "
               f"n + m = {system.n_dof + system.n_constraints}")
         for h in c["steps"]:
-            ends, outs = [], []
+            ends, outs, last = {k: [] for k in a.contraction}, {k: [] for k in a.contraction}, {}
             for _ in range(a.repeats):
-                cpu_end, res = _run(system, h, t_end, [0.0, t_end])
-                cpu_out, _ = _run(system, h, t_end, every)
-                ends.append(cpu_end)
-                outs.append(cpu_out)
-            st, steps = res.stats, res.stats["steps"]
-            e, o = float(np.median(ends)), float(np.median(outs))
-            print(f"  h = {h:g}: {st['newton_iterations'] / steps:.2f} iterations and {st['jacobian_evals'] / steps:.3f} "
-                  f"refreshes a step; {e / steps * 1e6:.1f} us a step (output at the end only), "
-                  f"{(o - e) / (every.size - 1) * 1e6:.0f} us more per output time")
-        N = system.n_dof + system.n_constraints
-        t_lu, t_solve = _dense(N)
-        print(f"  dense LU of {N} unknowns {t_lu * 1e6:.1f} us, one solve {t_solve * 1e6:.2f} us")
+                for k in a.contraction:
+                    cpu_end, last[k] = _run(system, h, t_end, [0.0, t_end], k)
+                    cpu_out, _ = _run(system, h, t_end, every, k)
+                    ends[k].append(cpu_end)
+                    outs[k].append(cpu_out)
+            for k in a.contraction:
+                res = last[k]
+                st, steps = res.stats, res.stats["steps"]
+                e, o = float(np.median(ends[k])), float(np.median(outs[k]))
+                print(f"  h = {h:g}, contraction {res.options['newton']['contraction']:g}: "
+                      f"{st['newton_iterations'] / steps:.2f} iterations and {st['jacobian_evals'] / steps:.3f} "
+                      f"refreshes a step; {e / steps * 1e6:.1f} us a step (output at the end only), "
+                      f"{(o - e) / (every.size - 1) * 1e6:.0f} us more per output time", flush=True)
+        resid, solve, fill, lu, kl, ku = _pieces(system, res)
+        print(f"  one iteration: residual {resid:.2f} us, solve {solve:.2f} us; one refresh: KKT fill (with the beam's "
+              f"tangent) {fill:.2f} us, fill and band LU {lu:.2f} us (band order: {kl} sub-, {ku} super-diagonals)")
 
 
 if __name__ == "__main__":

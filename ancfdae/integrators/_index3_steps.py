@@ -7,15 +7,16 @@ is a :class:`ancfdae.System` of one beam whose element offers compiled index-3 s
 compiled set (its :attr:`~ancfdae.System.compiled_arrays`, :mod:`ancfdae.system_compiled`), :class:`Index3Steps`
 runs the steps in one compiled call (contract and decisions in
 :mod:`ancfdae.integrators._index3_steps_numba`): the predictor, the modified-Newton iterations, the refresh
-of the KKT matrix and its dense LU, the update of ``q, v, a, ah, lam`` and the counters. The time functions
+of the KKT matrix and its LU (band storage, in the band order of :attr:`SystemArrays.kkt`), the update of ``q, v, a, ah, lam`` and the counters. The time functions
 (the joints' drives, the rigid bodies' and the beam's loads) are evaluated here, before the call, at the ends
 of the coming steps: one call of each user function per step (a table kept for :data:`TABLE_STEPS` steps),
 not one per iteration.
 
 A step that needs a decision of Python (a failure, the solver's retry) is taken by the ordinary Python step,
-which redoes it from its start with the factors the compiled steps left (a dense factorisation is handed
+which redoes it from its start with the factors the compiled steps left (their band factors are handed
 over as such). The Python path stays the reference: the tests hold states, multipliers and counters equal
-to it on B5 and B6 (the dense LU rounds differently from LAPACK's banded one, so states agree to round-off).
+to it on B5 and B6 (the LU in band order rounds differently from LAPACK's of the System's order, so states agree to
+round-off).
 """
 from __future__ import annotations
 
@@ -32,23 +33,25 @@ __all__ = ["Index3Steps"]
 
 #: at most this many steps per compiled call (Ctrl-C and the progress bar are served between calls)
 STEPS_PER_CALL = 500
+_NO_TIMES = np.zeros(0)
+
 #: the time functions are tabulated this many steps ahead: one table serves the calls up to several output times
 #: (the user's functions are called once per step either way; the Python around them is paid once per table)
 TABLE_STEPS = 256
 
 
-class _DenseLU:
-    """The compiled steps' dense factorisation, handed to the Python solver (``solve`` as its factors')."""
+class _KKTFactors:
+    """The compiled steps' band factors of the KKT matrix (band order), handed to the Python solver (``solve``
+    as its factors')."""
 
-    __slots__ = ("lu", "piv")
+    __slots__ = ("ab", "piv", "kkt")
 
-    def __init__(self, lu, piv):
-        self.lu, self.piv = lu, piv
+    def __init__(self, ab, piv, kkt):
+        self.ab, self.piv, self.kkt = ab, piv, kkt
 
     def solve(self, rhs):
-        x = np.array(rhs, dtype=float)
-        sn.dense_solve(self.lu, self.piv, x)
-        return x
+        rhs = np.ascontiguousarray(rhs, dtype=float)
+        return sn.kkt_solve(self.ab, self.piv, self.kkt, rhs, np.empty(rhs.size), np.empty(rhs.size))
 
 
 class Index3Steps:
@@ -66,11 +69,11 @@ class Index3Steps:
             s.t0, s.h, s.t_bound, s.beta, s.gamma, s.alpha_m, s.alpha_f, o.tol, o.contraction, GRID_TOL,
             s._mscale, o.xtol, arrays.load_factor, s.FLOOR_ROUNDOFF)
         self._fpar = f
-        N = model.n_dof + model.n_constraints
-        self._LU, self._piv = np.zeros((N, N)), np.zeros(N, dtype=np.int64)
-        self._LUs, self._pivs = np.zeros((N, N)), np.zeros(N, dtype=np.int64)
+        N, (_, kl, ku) = model.n_dof + model.n_constraints, arrays.kkt
+        self._AB, self._piv = np.zeros((N, 2 * kl + ku + 1)), np.zeros(N, dtype=np.int64)
+        self._ABs, self._pivs = np.zeros_like(self._AB), np.zeros(N, dtype=np.int64)
         self._no_band = (np.zeros((1, 1), order="F"), np.zeros(1, dtype=np.int32))   # LAPACK's types
-        self._table, self._grid = (0, np.zeros((0, arrays.n_weights)), None), None   # (first step, W, E), grid
+        self._table, self._grid = (0, np.zeros((0, 3, arrays.n_weights)), None), None   # (first step, W, E), grid
 
     @classmethod
     def offer(cls, stepper) -> "Index3Steps | None":
@@ -81,22 +84,23 @@ class Index3Steps:
         arrays = getattr(stepper.model.wrapped, "compiled_arrays", None)
         return None if arrays is None else cls(stepper, arrays)
 
-    def _tables(self, t_stop, max_count):
-        """``(W, E)``: the time weights and the beam's external force at the ends of the coming steps (at least
-        up to ``t_stop``), or ``(None, None)`` when a time function fails there (the Python steps reach it and
+    def _tables(self, t_stop, max_count, t_next):
+        """``(W, E)``: the time weights with their two derivatives and the beam's external force at the ends of the
+        coming steps (up to ``t_stop``; where a time function fails before, up to ``t_next``, the next output time:
+        the call stops there), or ``(None, None)`` when it fails before ``t_next`` (the Python steps reach it and
         fail at its step). Tabulated :data:`TABLE_STEPS` steps ahead and kept: one table serves several calls."""
         s = self._stepper
         h, first = s.h, s.n_steps + 1
-        k = int(max(1, min(max_count, (t_stop - s.t) / h + 2)))
+        k, k_next = (int(max(1, min(max_count, (tt - s.t) / h + 2))) for tt in (t_stop, t_next))
         start, W, E = self._table
         if not (start <= first and first + k <= start + W.shape[0] and self._grid == (s.t0, h, s.t_bound)):
             W = E = None
-            for size in (max(k, TABLE_STEPS), k):   # a bad time ahead: only the steps needed now
+            for size in (max(k, TABLE_STEPS), k, k_next):   # a bad time ahead: only the steps needed now
                 t_new = s.t0 + (first + np.arange(size)) * h
                 t_new[t_new >= s.t_bound - GRID_TOL * h] = s.t_bound
                 t_new = t_new[:int(np.searchsorted(t_new, s.t_bound)) + 1]   # nothing past the end
                 try:
-                    W, E = self._arrays.weights(t_new), self._arrays.external(t_new)
+                    W, E = self._arrays.weights(t_new, True), self._arrays.external(t_new)
                     break
                 except ValueError:
                     continue
@@ -106,23 +110,30 @@ class Index3Steps:
         i = first - start
         return W[i:], (E if E.shape[0] == 1 else E[i:])
 
-    def run(self, t_stop: float, max_count: int) -> tuple[StepOutcome, int]:
-        """``(outcome, taken)`` as :meth:`ancfdae.integrators.newmark._AlphaFamily.steps_until`."""
+    def run(self, t_stop: float, max_count: int, t_out=None) -> tuple[StepOutcome, int, tuple | None]:
+        """``(outcome, taken, samples)`` as :meth:`ancfdae.integrators.newmark._AlphaFamily.steps_sampling`: with the
+        coming output times ``t_out`` (``t_stop`` the last one this call may reach), ``samples = (t, q, v, a, lam)``
+        at those that accepted steps reached (rows; None without ``t_out``)."""
         s = self._stepper
         newton = s.newton
         lu = newton._lu
         inner = getattr(lu, "_lu", None)
         kind, lub, bpiv, kl, ku = sn.NONE, *self._no_band, 0, 0
-        if isinstance(inner, _DenseLU) and inner.lu is self._LU:
-            kind = sn.DENSE
+        if isinstance(inner, _KKTFactors) and inner.ab is self._AB:
+            kind = sn.OWN
         elif isinstance(inner, _Banded) and inner.dtype == np.float64:
             kind, lub, bpiv, kl, ku = sn.BAND, inner.lub, inner.piv, inner.kl, inner.ku
         elif lu is not None:
-            return s.step(), 0
+            return s.step(), 0, None
         max_count = min(max_count, STEPS_PER_CALL)
-        W, E = self._tables(t_stop, max_count)
+        T_rec = _NO_TIMES
+        if t_out is not None:   # at most max_count - 1 steps accepted here: the next output time stops the call
+            T_rec = np.array(t_out[:max_count - 1], dtype=float)   # a copy: the steps' times are written into it
+            if T_rec.size < len(t_out):
+                t_stop = min(t_stop, float(t_out[T_rec.size]))
+        W, E = self._tables(t_stop, max_count, t_stop if t_out is None or not len(t_out) else float(t_out[0]))
         if W is None:
-            return s.step(), 0
+            return s.step(), 0, None
         f = self._fpar.copy()
         f[sn.T], f[sn.T_STOP], f[sn.H_MATRIX], f[sn.ATOL], f[sn.FLOOR] = (s.t, t_stop, s._h_matrix or 0.0, s._atol,
                                                                           s._floor)
@@ -133,9 +144,12 @@ class Index3Steps:
         S[0], S[1], S[2], S[3], L[0], L[1] = s.q, s.v, s.a, s._ah, s.lam, s.lam
         out = np.zeros(sn.N_OUT, dtype=np.int64)
         a = self._arrays
-        self._fn(S, P, L, f, ipar, out, self._LU, self._piv, self._LUs, self._pivs, lub, bpiv, W, E, a.cons, a.rigid,
-                 a.beam, a.element_args)
-        done, status, iterations, evals, jacs = (int(x) for x in out)
+        rec = (np.empty((T_rec.size, n)), np.empty((T_rec.size, n)), np.empty((T_rec.size, n)),
+               np.empty((T_rec.size, m)))
+        self._fn(S, P, L, f, ipar, out, self._AB, self._piv, self._ABs, self._pivs, lub, bpiv, W, E, a.cons, a.rigid,
+                 a.beam, a.element_args, a.kkt, T_rec, *rec)
+        done, status, iterations, evals, jacs, k = (int(x) for x in out)
+        samples = None if t_out is None else (T_rec[:k], *(x[:k] for x in rec))
         st = newton.stats
         st.iterations += iterations
         st.residual_evals += evals
@@ -146,19 +160,19 @@ class Index3Steps:
         s.model.n_jacobian += jacs
         s._floor = float(f[sn.FLOOR])
         s._h_matrix = float(f[sn.H_MATRIX]) if ipar[sn.HAVE_H] else None
-        if ipar[sn.KIND] == sn.DENSE and kind != sn.DENSE or ipar[sn.KIND] == sn.NONE:
+        if ipar[sn.KIND] == sn.OWN and kind != sn.OWN or ipar[sn.KIND] == sn.NONE:
             newton._lu = None
-            if ipar[sn.KIND] == sn.DENSE:
+            if ipar[sn.KIND] == sn.OWN:
                 newton._lu = _Factor.__new__(_Factor)
-                newton._lu._lu = _DenseLU(self._LU, self._piv)
+                newton._lu._lu = _KKTFactors(self._AB, self._piv, a.kkt)
         if status == sn.STOPPED and done:   # the last step is the driver's to accept
             s.t, s.q, s.v, s.a, s._ah, s.lam = float(f[sn.T_PREV]), P[0], P[1], P[2], P[3], L[1]
             s.previous = None
             s.n_steps += done - 1
             s._ah_next = S[3]
-            return StepOutcome(ok=True, t=float(f[sn.T]), q=S[0], v=S[1], a=S[2], lam=L[0]), done - 1
+            return StepOutcome(ok=True, t=float(f[sn.T]), q=S[0], v=S[1], a=S[2], lam=L[0]), done - 1, samples
         if done:
             s.previous = (float(f[sn.T_PREV]), P[0], P[1], P[2])
             s.t, s.q, s.v, s.a, s._ah, s.lam = float(f[sn.T]), S[0], S[1], S[2], S[3], L[0]
             s.n_steps += done
-        return s.step(), done
+        return s.step(), done, samples

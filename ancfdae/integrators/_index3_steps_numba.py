@@ -6,21 +6,34 @@ offers a fused kernel and any number of rigid bodies, every constraint row folde
 (:mod:`ancfdae.joints.assembled_numba`). Per Newton iteration: the substitution with the cached factors, the
 update of ``x = [y, mu]``, the step's states, the beam's fused residual and ``+ M a - lambda f_ext``, the rigid
 bodies' ``M a - f(t, q) - f_g``, ``(g, G^T lam)`` in one pass, the norms and the solver's decisions. A refresh
-assembles the KKT matrix ``[[K + s M + H(lam), sm G^T], [sm G, 0]]`` densely (the beam's tangent from its
-fused kernel, ``H`` and ``G`` on their fixed patterns) and factorises it with partial pivoting
-(:func:`dense_lu`); the round-off floor is the Python path's. The entry point::
+assembles the KKT matrix ``[[K + s M + H(lam), sm G^T], [sm G, 0]]`` (the beam's tangent from its fused kernel,
+``H`` and ``G`` on their fixed patterns) in band storage, its unknowns in the band order of
+:attr:`ancfdae.system_compiled.SystemArrays.kkt` (reverse Cuthill-McKee of its pattern: B6's 62 unknowns have 8 sub-
+and 8 super-diagonals, 57 in the System's order), and factorises it with partial pivoting inside the band
+(:func:`~ancfdae.integrators._linsolve_numba.band_factor`, LAPACK's ``dgbtf2`` elimination); the round-off floor
+is the Python path's. The entry point::
 
-    steps(S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv, W, E, cons, rigid, beam, element_args)
+    steps(S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv, W, E, cons, rigid, beam, element_args, kkt,
+          T_rec, rec_q, rec_v, rec_a, rec_lam)
 
 * ``S`` (4, n): ``q, v, a, ah`` (``ah`` the algorithmic acceleration) at ``fpar[T]`` on entry, the state
   reached on return; ``P`` (4, n) the state before the last step taken; ``L`` (2, m): the multipliers
   reached and those before the last step.
-* ``LU, piv``: a dense factorisation (written at each refresh), ``LUs, pivs`` its copy at the start of a
-  step that refreshed; ``lub, bpiv``: LAPACK's banded factors the Python path left (``ipar[KIND] = BAND``).
-* ``W`` (k, nw): per coming step, the time weights at its end (the constraint terms' row 0 of
-  :meth:`~ancfdae.joints.assembled.ConstraintSet.weights`, then the rigid bodies' load factors); ``E``
+* ``AB, piv``: the band factors of the KKT matrix in band order (``(n + m, 2 kl + ku + 1)``, the layout of
+  :func:`~ancfdae.integrators._linsolve_numba.band_factor`; written at each refresh, ``ipar[KIND] = OWN``),
+  ``ABs, pivs`` their copy at the start of a step that refreshed; ``lub, bpiv``: LAPACK's banded factors of the
+  matrix in the System's order that the Python path left (``ipar[KIND] = BAND``, its ``KL``, ``KU``).
+* ``W`` (k, 3, nw): per coming step, the time weights at its end and their first two derivatives (the constraint
+  terms' :meth:`~ancfdae.joints.assembled.ConstraintSet.weights`, then the rigid bodies' load factors); ``E``
   (k or 1, nb): the beam's external force at each step's end (one row: constant).
-* ``cons``, ``rigid``, ``beam``: the arrays of :class:`ancfdae.integrators._index3_steps.Index3Steps`.
+* ``cons``, ``rigid``, ``beam``, ``kkt``: the arrays of :class:`ancfdae.system_compiled.SystemArrays`
+  (``kkt = (pos, kl, ku)``: unknown ``i`` at row and column ``pos[i]`` of the band-ordered matrix).
+
+* ``T_rec``: the coming output times (ascending, those after ``t_stop`` ignored). A step accepted here whose end is one
+  of them (to ``GRID_TOL``) is recorded: ``q, v, a`` into row ``out[RECORDED]`` of ``rec_q, rec_v, rec_a`` and the
+  multipliers of :func:`system_multipliers` (the driver's, :func:`ancfdae.constrained.multipliers`) into ``rec_lam``;
+  a step that passes one inside (the driver interpolates) or whose multipliers are not finite (the driver's solve
+  raises) stops the call, handed to the driver like the last one.
 
 Status ``STOPPED`` (the last step reached ``t_stop`` or the end, or ``max_count`` steps were taken) or
 ``NEEDS_PYTHON``: the next step needs a decision of Python (a non-finite value, a failed attempt that the
@@ -34,12 +47,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ancfdae.integrators._linsolve_numba import band_solve
+from ancfdae.integrators._linsolve_numba import band_factor, band_solve
 from ancfdae._scale import max_abs
 from ancfdae.joints.assembled_numba import _g_force, _rates
 from ancfdae._residual_numba import finish_residual
 
-__all__ = ["index3_steps", "system_multipliers", "dense_lu", "dense_solve"]
+__all__ = ["index3_steps", "system_multipliers", "kkt_solve"]
 
 # fpar
 T0, H, T, T_BOUND, T_STOP, H_MATRIX, BETA, GAMMA, ALPHA_M, ALPHA_F, TOL, ATOL, FLOOR, CONTRACTION, GRID_TOL, \
@@ -48,63 +61,41 @@ N_FPAR = 20
 # ipar
 N_STEPS, MAX_COUNT, MAX_ITER, KIND, HAVE_H, KL, KU = range(7)
 N_IPAR = 7
-# ipar[KIND]
-NONE, DENSE, BAND = 0, 1, 2
+# ipar[KIND]: no factors, the steps' own band factors (AB, piv), LAPACK's of the Python path (lub, bpiv)
+NONE, OWN, BAND = 0, 1, 2
 # out
-DONE, STATUS, ITERATIONS, RESIDUALS, JACOBIANS = range(5)
-N_OUT = 5
+DONE, STATUS, ITERATIONS, RESIDUALS, JACOBIANS, RECORDED = range(6)
+N_OUT = 6
 STOPPED, NEEDS_PYTHON = 0, 1
 
 
+@njit(inline="always")
+def _put(AB, kv, pos, i, j, val):
+    """``A[i, j] += val`` of the KKT matrix: row and column ``pos[.]`` of the band order, band storage."""
+    pi, pj = pos[i], pos[j]
+    AB[pj, kv + pi - pj] += val
+
+
 @njit(cache=True, error_model="numpy")   # a zero pivot gives inf/nan, as LAPACK does
-def dense_lu(A, piv):
-    """``A = P L U`` in place (row-major Doolittle with partial pivoting, LAPACK's ``getrf`` convention:
-    row ``k`` was swapped with row ``piv[k]``)."""
-    n = A.shape[0]
-    for k in range(n):
-        p, big = k, abs(A[k, k])
-        for i in range(k + 1, n):
-            if abs(A[i, k]) > big:
-                p, big = i, abs(A[i, k])
-        piv[k] = p
-        if p != k:
-            for j in range(n):
-                A[k, j], A[p, j] = A[p, j], A[k, j]
-        d = A[k, k]
-        for i in range(k + 1, n):
-            lik = A[i, k] / d
-            A[i, k] = lik
-            if lik != 0.0:
-                for j in range(k + 1, n):
-                    A[i, j] -= lik * A[k, j]
-
-
-@njit(cache=True, error_model="numpy")
-def dense_solve(LU, piv, b):
-    """Solve ``A x = b`` in place in ``b`` with the factors of :func:`dense_lu`."""
-    n = b.size
-    for k in range(n):
-        p = piv[k]
-        if p != k:
-            b[k], b[p] = b[p], b[k]
-    for i in range(n):
-        s = b[i]
-        for j in range(i):
-            s -= LU[i, j] * b[j]
-        b[i] = s
-    for i in range(n - 1, -1, -1):
-        s = b[i]
-        for j in range(i + 1, n):
-            s -= LU[i, j] * b[j]
-        b[i] = s / LU[i, i]
+def kkt_solve(AB, piv, kkt, r, d, b):
+    """``d = A^-1 r`` with the band factors ``AB, piv`` of the KKT matrix in band order (``d`` returned, ``b`` a
+    work array, both of ``r``'s size); ``r`` is in the System's order, and so is the result."""
+    pos, kl, ku = kkt
+    for i in range(r.size):
+        b[pos[i]] = r[i]
+    band_solve(AB.T, kl, ku, piv, b)
+    for i in range(r.size):
+        d[i] = b[pos[i]]
+    return d
 
 
 @njit(cache=True)
-def _rigid_residual(r, q, a, w, rigid):
-    """``r_i = (M a)_i - f_i(t, q) - f_g,i`` on the rigid bodies' coordinates (``RigidBody.residual``)."""
+def _rigid_residual(r, q, a, w, rigid, f, ma):
+    """``r_i = (M a)_i - f_i(t, q) - f_g,i`` on the rigid bodies' coordinates (``RigidBody.residual``); ``f``,
+    ``ma``: work arrays of ``r``'s size."""
     ridx, mi, mj, mv, grav, fvec, fcol, ci, cj, cv, ccol = rigid
-    f = np.zeros(r.size)
-    ma = np.zeros(r.size)
+    f[:] = 0.0
+    ma[:] = 0.0
     for k in range(fcol.size):
         s = w[fcol[k]]
         for i in ridx:
@@ -118,10 +109,11 @@ def _rigid_residual(r, q, a, w, rigid):
 
 
 @njit(inline="always")
-def _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid, beam, eargs, rbuf, kbuf):
-    """The step's residual ``[r(t1, q1, v1, a1) + G^T lam; sm g]`` at ``x`` into ``r``; returns ``(max|r|, q1)``."""
+def _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid, beam, eargs, rbuf, kbuf, work):
+    """The step's residual ``[r(t1, q1, v1, a1) + G^T lam; sm g]`` at ``x`` into ``r``; returns ``(max|r|, q1)``
+    (``q1`` in the work arrays ``work = (q, v, a, lam, g, f, f2, ma)``, overwritten by the next call)."""
     ob, nb, q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices = beam
-    q, v, a, lam = np.empty(n), np.empty(n), np.empty(n), np.empty(m)
+    q, v, a, lam, g, f, f2, ma = work
     for i in range(n):
         y = x[i]
         q[i] = qp[i] + y
@@ -131,10 +123,9 @@ def _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid
         lam[i] = sm * x[n + i]
     fused(q[ob:ob + nb], q_fixed, gather, vec_slot, mat_slot, False, rbuf, kbuf, *eargs)
     finish_residual(rbuf, m_data, indptr, indices, a[ob:ob + nb], lf, ext)
-    _rigid_residual(r, q, a, w, rigid)
+    _rigid_residual(r, q, a, w, rigid, f2, ma)
     for i in range(nb):
         r[ob + i] = rbuf[i]
-    g, f = np.empty(m), np.empty(n)
     lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa = cons[:11]
     _g_force(w, lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa, q, lam, g, f)
     for i in range(n):
@@ -145,29 +136,32 @@ def _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid
 
 
 @njit(inline="always")
-def _matrix(fused, A, x, q, n, m, s, sm, w, cons, rigid, beam, eargs, rbuf, kbuf):
-    """The KKT matrix at ``x`` (state ``q``) into ``A`` (dense); returns ``max(max|K|, max|sm G|)``."""
+def _matrix(fused, AB, x, q, n, m, s, sm, w, cons, rigid, beam, eargs, rbuf, kbuf, kkt):
+    """The KKT matrix at ``x`` (state ``q``) into ``AB`` (band order and storage, ``kkt``); returns
+    ``(max|K|, max|sm G|)``."""
     ob, nb, q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices = beam
     lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa, ls, qslot, g_indptr, g_indices = cons
     ridx, mi, mj, mv, grav, fvec, fcol, ci, cj, cvv, ccol = rigid
-    A[:, :] = 0.0
+    pos, kl, ku = kkt
+    kv = kl + ku
+    AB[:, :] = 0.0
     fused(q[ob:ob + nb], q_fixed, gather, vec_slot, mat_slot, True, rbuf, kbuf, *eargs)
     kmax = 0.0
     for i in range(nb):
         for jj in range(indptr[i], indptr[i + 1]):
-            A[ob + i, ob + indices[jj]] += kbuf[jj] + s * m_data[jj]
+            _put(AB, kv, pos, ob + i, ob + indices[jj], kbuf[jj] + s * m_data[jj])
             kmax = max(kmax, abs(kbuf[jj]))
     for e in range(mi.size):
-        A[mi[e], mj[e]] += s * mv[e]
+        _put(AB, kv, pos, mi[e], mj[e], s * mv[e])
     for e in range(ci.size):
         k = -(w[ccol[e]] * cvv[e])
-        A[ci[e], cj[e]] += k
+        _put(AB, kv, pos, ci[e], cj[e], k)
         kmax = max(kmax, abs(k))
     lam = np.empty(m)
     for i in range(m):
         lam[i] = sm * x[n + i]
     for e in range(qi.size):   # H(lam) = sum_i lam_i A_i
-        A[qj[e], qk[e]] += qa[e] * lam[qi[e]]
+        _put(AB, kv, pos, qj[e], qk[e], qa[e] * lam[qi[e]])
     gdata = np.zeros(g_indices.size)
     for e in range(lt.size):
         gdata[ls[e]] += w[lt[e]] * lv[e]
@@ -177,14 +171,15 @@ def _matrix(fused, A, x, q, n, m, s, sm, w, cons, rigid, beam, eargs, rbuf, kbuf
     for i in range(m):
         for jj in range(g_indptr[i], g_indptr[i + 1]):
             val = sm * gdata[jj]
-            A[n + i, g_indices[jj]] += val
-            A[g_indices[jj], n + i] += val
+            _put(AB, kv, pos, n + i, g_indices[jj], val)
+            _put(AB, kv, pos, g_indices[jj], n + i, val)
             gmax = max(gmax, abs(val))
     return kmax, gmax
 
 
 @njit(inline="always")
-def index3_steps(fused, S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv, W, E, cons, rigid, beam, eargs):
+def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv, W, E, cons, rigid, beam, eargs,
+                 kkt, T_rec, rec_q, rec_v, rec_a, rec_lam):
     """Index-3 steps until ``t_stop``, the end, ``max_count`` steps or a decision for Python (module docstring)."""
     n, m = S.shape[1], L.shape[1]
     N = n + m
@@ -196,12 +191,13 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv,
     n_steps, max_count, max_iter = ipar[N_STEPS], min(ipar[MAX_COUNT], W.shape[0]), ipar[MAX_ITER]
     kind, kl, ku = ipar[KIND], ipar[KL], ipar[KU]
     have_h, h_matrix, floor = ipar[HAVE_H], fpar[H_MATRIX], fpar[FLOOR]
-    A = np.empty((N, N))
-    x, r, dx = np.empty(N), np.empty(N), np.empty(N)
+    x, r, dx, bx = np.empty(N), np.empty(N), np.empty(N), np.empty(N)
     rbuf, kbuf = np.empty(nb + 1), np.empty(beam[6].size + 1)
     qp, vp, ca = np.empty(n), np.empty(n), np.empty(n)
+    work = (np.empty(n), np.empty(n), np.empty(n), np.empty(m), np.empty(m), np.empty(n), np.empty(n), np.empty(n))
     t = fpar[T]
-    done, iters, evals, jacs, status = 0, 0, 0, 0, NEEDS_PYTHON
+    done, iters, evals, jacs, status, nrec = 0, 0, 0, 0, NEEDS_PYTHON, 0
+    a_scratch = np.empty(n)
     eps = np.finfo(np.float64).eps
     while done < max_count:
         t_new = t0 + (n_steps + done + 1) * h
@@ -213,8 +209,9 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv,
         if have_h == 0 or abs(hs - h_matrix) > 1e-8 * h:
             kind, have_h, h_matrix = NONE, 1, hs
         # index3_equations
-        w = W[done]
+        w = W[done, 0]
         ext = E[done] if E.shape[0] > 1 else E[0]
+        wi = done
         s = (1.0 - am) / ((1.0 - af) * beta * hs * hs)
         sm = s * mscale
         c_v = gamma / (beta * hs)
@@ -229,7 +226,7 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv,
             x[n + i] = L[0, i] / sm
         # NewtonSolver.solve and _attempt (modified Newton)
         err, q = _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid, beam, eargs,
-                           rbuf, kbuf)
+                           rbuf, kbuf, work)
         its, ev, jc, saved = 0, 1, 0, False
         ok = np.isfinite(err)
         if ok:
@@ -240,21 +237,20 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv,
             while not converged and k < max_iter:
                 k += 1
                 if kind == NONE:
-                    if kind0 == DENSE and not saved:   # kept to restore if Python must redo the step
-                        LUs[:, :] = LU
+                    if kind0 == OWN and not saved:   # kept to restore if Python must redo the step
+                        ABs[:, :] = AB
                         pivs[:] = piv
                         saved = True
-                    kmax, gmax = _matrix(fused, A, x, q, n, m, s, sm, w, cons, rigid, beam, eargs, rbuf, kbuf)
+                    kmax, gmax = _matrix(fused, AB, x, q, n, m, s, sm, w, cons, rigid, beam, eargs, rbuf, kbuf, kkt)
                     qm = max(1.0, max_abs(q))
                     floor = max(floor, max(ffac * eps * kmax * qm, ffac * eps * gmax * qm))
-                    LU[:, :] = A
-                    dense_lu(LU, piv)
-                    kind, fresh, jc = DENSE, True, jc + 1
+                    band_factor(AB, kkt[1], kkt[2], piv)
+                    kind, fresh, jc = OWN, True, jc + 1
                     threshold = max(rel, floor)
-                dx[:] = r
-                if kind == DENSE:
-                    dense_solve(LU, piv, dx)
+                if kind == OWN:
+                    kkt_solve(AB, piv, kkt, r, dx, bx)
                 else:
+                    dx[:] = r
                     band_solve(lub, kl, ku, bpiv, dx)
                 its += 1
                 dx_max = max_abs(dx)
@@ -264,7 +260,7 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv,
                 for i in range(N):
                     x[i] = x[i] - dx[i]
                 err_new, q = _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid, beam,
-                                       eargs, rbuf, kbuf)
+                                       eargs, rbuf, kbuf, work)
                 ev += 1
                 if not np.isfinite(err_new):
                     ok = False
@@ -295,7 +291,7 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv,
                     ok = False
         if not ok:   # Python redoes this step from its start: its state, factors and floor as they were
             if saved:
-                LU[:, :] = LUs
+                AB[:, :] = ABs
                 piv[:] = pivs
             kind, floor, have_h, h_matrix = kind0, floor0, have_h0, h_matrix0
             break
@@ -315,21 +311,36 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv,
         done += 1
         t_prev, t = t, t_new
         fpar[T_PREV], fpar[T] = t_prev, t
-        if t >= t_bound or t_stop <= t + grid_tol * (t - t_prev):
+        tol_t = grid_tol * (t - t_prev)
+        if t >= t_bound or t_stop <= t + tol_t or done == max_count:
             status = STOPPED
             break
-    if done == max_count:
-        status = STOPPED
+        if nrec < rec_q.shape[0] and T_rec[nrec] <= t + tol_t:   # an output time reached (the driver's test)
+            if abs(T_rec[nrec] - t) > tol_t:   # inside the step: the driver interpolates
+                status = STOPPED
+                break
+            system_multipliers(fused, W[wi], ext, S[0], S[1], a_scratch, rec_lam[nrec], cons, rigid, beam, eargs, lf,
+                               kkt)
+            if not np.isfinite(max_abs(rec_lam[nrec])):   # the driver's solve reports it
+                status = STOPPED
+                break
+            T_rec[nrec] = t   # the step's time, as the driver records it
+            rec_q[nrec, :] = S[0]
+            rec_v[nrec, :] = S[1]
+            rec_a[nrec, :] = S[2]
+            nrec += 1
     fpar[FLOOR], fpar[H_MATRIX] = floor, h_matrix
     ipar[KIND], ipar[HAVE_H] = kind, have_h
-    out[DONE], out[STATUS], out[ITERATIONS], out[RESIDUALS], out[JACOBIANS] = done, status, iters, evals, jacs
+    out[DONE], out[STATUS], out[ITERATIONS], out[RESIDUALS], out[JACOBIANS], out[RECORDED] = (done, status, iters,
+                                                                                           evals, jacs, nrec)
 
 
 @njit(inline="always")
-def system_multipliers(fused, W, ext, q, v, a_out, lam_out, cons, rigid, beam, eargs, lf):
+def system_multipliers(fused, W, ext, q, v, a_out, lam_out, cons, rigid, beam, eargs, lf, kkt):
     """``(a, lam)`` from ``[[M, G^T], [G, 0]] [a; lam] = [-r(t, q, v, 0); gamma]`` (:func:`ancfdae.constrained.multipliers`)
     into ``a_out``, ``lam_out``: ``W`` (3, nw) the time weights at ``t`` and their derivatives, ``ext`` the beam's
-    external force at ``t``, ``lf`` its load factor; a singular matrix gives non-finite values."""
+    external force at ``t``, ``lf`` its load factor; the matrix in the band order ``kkt`` (its pattern is in the
+    steps' KKT pattern); a singular matrix gives non-finite values."""
     n, m = q.size, lam_out.size
     N = n + m
     ob, nb, q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices = beam
@@ -339,17 +350,19 @@ def system_multipliers(fused, W, ext, q, v, a_out, lam_out, cons, rigid, beam, e
     rbuf, kbuf = np.empty(nb + 1), np.empty(1)
     fused(q[ob:ob + nb], q_fixed, gather, vec_slot, mat_slot, False, rbuf, kbuf, *eargs)
     finish_residual(rbuf, m_data, indptr, indices, zero[ob:ob + nb], lf, ext)
-    _rigid_residual(r, q, zero, W[0], rigid)
+    _rigid_residual(r, q, zero, W[0], rigid, np.empty(n), np.empty(n))
     for i in range(nb):
         r[ob + i] = rbuf[i]
     gt, gamma = np.empty(m), np.empty(m)
     _rates(W[1], W[2], lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa, q, v, gt, gamma)
-    A, rhs = np.zeros((N, N)), np.empty(N)
+    pos, kl, ku = kkt
+    kv = kl + ku
+    AB, rhs = np.zeros((N, 2 * kl + ku + 1)), np.empty(N)
     for i in range(nb):
         for jj in range(indptr[i], indptr[i + 1]):
-            A[ob + i, ob + indices[jj]] += m_data[jj]
+            _put(AB, kv, pos, ob + i, ob + indices[jj], m_data[jj])
     for e in range(mi.size):
-        A[mi[e], mj[e]] += mv[e]
+        _put(AB, kv, pos, mi[e], mj[e], mv[e])
     gdata = np.zeros(g_indices.size)
     for e in range(lt.size):
         gdata[ls[e]] += W[0, lt[e]] * lv[e]
@@ -357,16 +370,16 @@ def system_multipliers(fused, W, ext, q, v, a_out, lam_out, cons, rigid, beam, e
         gdata[qslot[e]] += qa[e] * q[qk[e]]
     for i in range(m):
         for jj in range(g_indptr[i], g_indptr[i + 1]):
-            A[n + i, g_indices[jj]] += gdata[jj]
-            A[g_indices[jj], n + i] += gdata[jj]
+            _put(AB, kv, pos, n + i, g_indices[jj], gdata[jj])
+            _put(AB, kv, pos, g_indices[jj], n + i, gdata[jj])
     for i in range(n):
         rhs[i] = -r[i]
     for i in range(m):
         rhs[n + i] = gamma[i]
     piv = np.empty(N, dtype=np.int64)
-    dense_lu(A, piv)
-    dense_solve(A, piv, rhs)
+    band_factor(AB, kl, ku, piv)
+    x = kkt_solve(AB, piv, kkt, rhs, np.empty(N), np.empty(N))
     for i in range(n):
-        a_out[i] = rhs[i]
+        a_out[i] = x[i]
     for i in range(m):
-        lam_out[i] = rhs[n + i]
+        lam_out[i] = x[n + i]

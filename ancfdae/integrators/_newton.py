@@ -20,6 +20,7 @@ Imitates the simplified Newton of scipy's ``radau.solve_collocation_system``
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import Callable
 
 import numpy as np
@@ -28,7 +29,7 @@ from numpy.typing import ArrayLike
 from .._scale import max_abs
 from ._linsolve import factorize
 from . import _newton_messages as says
-from ._newton_records import NewtonOptions, NewtonOutcome, NewtonStats
+from ._newton_records import CONTRACTION, NewtonOptions, NewtonOutcome, NewtonStats
 
 __all__ = ["NewtonSolver"]
 
@@ -85,9 +86,16 @@ class NewtonSolver:
             options = NewtonOptions()
         if not isinstance(options, NewtonOptions):
             raise TypeError(f"`options` must be a NewtonOptions, got {type(options).__name__}.")
-        self.options = options
+        #: as given (``contraction`` None: the method's choice, :meth:`choose_contraction`)
+        self.given = options
+        self.options = options if options.contraction is not None else replace(options, contraction=CONTRACTION)
         self.stats = NewtonStats()
         self._lu: _Factor | None = None
+
+    def choose_contraction(self, value: float) -> None:
+        """The method's refresh threshold ``value``, unless the user gave one (``NewtonOptions.contraction``)."""
+        if self.given.contraction is None:
+            self.options = replace(self.given, contraction=value)
 
     def invalidate(self) -> None:
         """Drop the cached factorisation; the next iteration refactorises."""

@@ -33,6 +33,10 @@ def _real(name, value, *, low=None, high=None, low_open=False, high_open=False):
     return float(value)
 
 
+#: modified Newton's refresh threshold on the contraction rate where neither the user nor the method chose one
+CONTRACTION = 0.3
+
+
 @validate.renamed("atol", "residual_atol", RENAMED_ATOL)
 @dataclass(frozen=True)
 class NewtonOptions:
@@ -60,9 +64,12 @@ class NewtonOptions:
         Iterations allowed per attempt (per retry as well). ``>= 1``.
     jacobian : {"modified", "full"}
         Refresh policy (see module docstring).
-    contraction : float
+    contraction : float or None
         Modified Newton refreshes the factorisation when the observed rate
-        ``max|r_{k+1}| / max|r_k|`` exceeds this value. In ``(0, 1)``.
+        ``max|r_{k+1}| / max|r_k|`` exceeds this value. In ``(0, 1)``. ``None``
+        (the default): the method's own, :data:`CONTRACTION` unless the method
+        says otherwise (the Newmark family on a constrained model:
+        :data:`ancfdae.integrators.newmark.INDEX3_CONTRACTION`).
     retry : bool
         Modified Newton only: retry a failed solve once from the initial guess
         with a fresh matrix when the failed attempt had used a stale one.
@@ -79,7 +86,7 @@ class NewtonOptions:
     residual_atol: float | None = None
     max_iter: int = 25
     jacobian: str = "modified"
-    contraction: float = 0.3
+    contraction: float | None = None
     retry: bool = True
     xtol: float = 1e-11
 
@@ -91,7 +98,8 @@ class NewtonOptions:
             raise ValueError(f"`max_iter` must be a positive integer, got {self.max_iter!r}.")
         if self.jacobian not in ("modified", "full"):
             raise ValueError(f"`jacobian` must be one of ['full', 'modified'], got {self.jacobian!r}.")
-        _real("contraction", self.contraction, low=0.0, high=1.0, low_open=True, high_open=True)
+        if self.contraction is not None:
+            _real("contraction", self.contraction, low=0.0, high=1.0, low_open=True, high_open=True)
         _real("xtol", self.xtol, low=0.0)
         if not isinstance(self.retry, bool):
             raise ValueError(f"`retry` must be True or False, got {self.retry!r}.")

@@ -77,6 +77,16 @@ class Recorder:
         if state is not None:
             self.state.append(state)
 
+    def record(self, t, q, v, a, lam):
+        """Record one output time whose multipliers the stepper solved as :meth:`sample` does (no monitors, no
+        event state: :meth:`ancfdae.integrators.newmark._AlphaFamily.steps_sampling`)."""
+        if self.constrained:
+            self.lam.append(np.array(lam, dtype=float))
+        self.t.append(float(t))
+        self.q.append(np.array(q, dtype=float))
+        self.v.append(np.array(v, dtype=float))
+        self.a.append(np.array(a, dtype=float))
+
     def stop_reason(self):
         """The first monitor's request to end the run, or None."""
         for m in self.monitors:

@@ -279,10 +279,19 @@ def integrate(stepper: Stepper, model: Model, t_span: tuple[float, float], t_eva
         # nothing needs the state between output times: a stepper may take the steps up to the next one at once
         until = getattr(stepper, "steps_until", None) if (
             t_out is not None and not rec.monitors and not hooks and not events) else None
+        sampling = getattr(stepper, "steps_sampling", None) if until is not None else None
         while True:
             if steps >= max_steps:
                 raise _Failed(f"more than max_steps = {max_steps} steps before t = {tf:g}")
-            if until is not None:   # the steps it accepted itself, then the last one's outcome
+            if sampling is not None:   # across output times: the samples it recorded (on steps it accepted), then as until
+                out, taken, samples = sampling(t_out[j:], tf, max_steps - steps)
+                if taken:
+                    steps, t = steps + taken, stepper.t
+                if samples is not None:
+                    for row in zip(*samples):
+                        rec.record(*row)
+                    j += len(samples[0])
+            elif until is not None:   # the steps it accepted itself, then the last one's outcome
                 out, taken = until(float(t_out[j]) if j < t_out.size else tf, max_steps - steps)
                 if taken:
                     steps, t = steps + taken, stepper.t

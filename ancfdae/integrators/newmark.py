@@ -44,7 +44,7 @@ from ancfdae.kkt import KKTAssembler
 from ancfdae.integrators._alpha_iteration import AlphaIteration
 from ancfdae.integrators._alpha_steps import AlphaSteps
 from ancfdae.integrators._index3_steps import Index3Steps
-from ancfdae.integrators._newton_records import NewtonOptions
+from ancfdae.integrators._newton_records import CONTRACTION, NewtonOptions
 from ancfdae.integrators.driver import consistent_acceleration
 from ancfdae.integrators.newton_stepper import NewtonStepper
 from ancfdae.integrators.protocol import StepOutcome
@@ -53,6 +53,14 @@ from ancfdae.problem import Model, capabilities
 __all__ = ["Newmark", "HHTAlpha", "GeneralizedAlpha"]
 
 _log = logging.getLogger("ancfdae")
+
+#: modified Newton's refresh threshold on a constrained model (index 3) unless the user gives ``contraction``:
+#: the matrix's error grows with its age as the joints turn (B6's crank: 0.02 rad a step at h = 2e-4), so the
+#: iterations of a stale matrix slow down step by step; a refresh (the KKT matrix in band order, about three
+#: iterations' cost) pays at a lower rate than on a beam alone. B6 over 0.5 s at h = 2e-4 / 1e-4 / 5e-5:
+#: 7.8-8.7 iterations a step at 0.3, 3.6-4.5 at 0.03 (0.12-0.41 refreshes), 26-35 % less CPU; B5 within noise
+#: (``python -m benchmarks.index3_cost --contraction 0.3 0.03``)
+INDEX3_CONTRACTION = 0.03
 
 
 def _param(name, value, low, high):
@@ -91,6 +99,7 @@ class _AlphaFamily(NewtonStepper):
         super()._setup()
         self._offer = self._steps = (None, None)
         self._constrained = "constraints" in capabilities(self.model)
+        self.newton.choose_contraction(INDEX3_CONTRACTION if self._constrained else CONTRACTION)
         if self._constrained:
             self._ah = self.a.copy()
             self._kkt = KKTAssembler()
@@ -189,13 +198,28 @@ class _AlphaFamily(NewtonStepper):
         """
         steps = self._compiled_steps()
         if self._constrained:
-            return steps.run(float(t_stop), int(max_count)) if steps is not None and max_count >= 1 else (self.step(), 0)
+            return steps.run(float(t_stop), int(max_count))[:2] if steps is not None and max_count >= 1 else (self.step(), 0)
         lu = self.newton._lu
         band = getattr(lu, "_lu", None)
         if (steps is None or max_count < 1 or self._h_matrix is None or getattr(band, "lub", None) is None
                 or not band._compiled or band.dtype != np.float64):
             return self.step(), 0
         return steps.run(band, float(t_stop), int(max_count))
+
+    def steps_sampling(self, t_out: np.ndarray, t_end: float, max_count: int) -> tuple[StepOutcome, int, tuple | None]:
+        """:meth:`steps_until` across several output times: ``(outcome, taken, samples)``.
+
+        On a System with compiled index-3 steps (:mod:`ancfdae.integrators._index3_steps`) one compiled call takes
+        the steps up to the last of the coming output times ``t_out`` (or ``t_end``) that it can, and records the
+        state and the reactions at each output time an accepted step ends on: ``samples = (t, q, v, a, lam)``
+        (rows), what the driver would record there. Otherwise ``samples`` is None and this is :meth:`steps_until`
+        up to ``t_out[0]``.
+        """
+        steps = self._compiled_steps() if self._constrained else None
+        t_stop = float(t_out[-1]) if len(t_out) else float(t_end)
+        if steps is None or max_count < 1:
+            return (*self.steps_until(float(t_out[0]) if len(t_out) else float(t_end), max_count), None)
+        return steps.run(t_stop, int(max_count), t_out)
 
     def _compiled_steps(self):
         """The model's compiled steps for this run (:class:`._alpha_steps.AlphaSteps`; constrained:

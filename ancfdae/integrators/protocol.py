@@ -124,7 +124,10 @@ class Stepper(Protocol):
     reaches ``t_stop`` (the next output time, as the driver tests it, or the end of the run); it
     accepts all but the last itself (``taken`` of them) and returns the last one's outcome (or the
     failure of the step after the accepted ones) for the driver to check and accept. The Newmark family
-    runs them as one compiled call (:mod:`ancfdae.integrators._alpha_steps`).
+    runs them as one compiled call (:mod:`ancfdae.integrators._alpha_steps`). Optional as well, then preferred:
+    ``steps_sampling(t_out, t_end, max_count) -> (outcome, taken, samples)``, the same across the coming output
+    times ``t_out``, with ``samples = (t, q, v, a, lam)`` (rows, or None) at those its accepted steps ended on,
+    recorded as the driver would (the Newmark family on a compiled System: :mod:`ancfdae.integrators._index3_steps`).
     """
 
     name: str

@@ -170,3 +170,17 @@ def test_bad_solver_arguments():
         NewtonSolver({"tol": 1e-8})
     with pytest.raises(ValueError, match="shape"):
         NewtonSolver().solve(lambda x: np.zeros(3), lambda x: sp.eye(2), np.ones(2))
+
+
+def test_contraction_left_to_the_method():
+    # catches: None reaching the solver's rate test, the method's threshold overriding the user's, or lost on reuse
+    from ancfdae.integrators._newton_records import CONTRACTION
+    s = NewtonSolver(NewtonOptions())
+    assert s.options.contraction == CONTRACTION
+    s.choose_contraction(0.05)
+    assert s.options.contraction == 0.05
+    s.choose_contraction(CONTRACTION)
+    assert s.options.contraction == CONTRACTION
+    given = NewtonSolver(NewtonOptions(contraction=0.2))
+    given.choose_contraction(0.05)
+    assert given.options.contraction == 0.2

@@ -258,17 +258,18 @@ def be2d_static_newton(x, r, f_ext, fpar, ipar, flat, ab, piv, kdata, rbuf, arra
 
 
 @njit(cache=True)
-def be2d_index3_steps(S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv, W, E, cons, rigid, beam, element_args):
+def be2d_index3_steps(S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv, W, E, cons, rigid, beam, element_args,
+                      kkt, T_rec, rec_q, rec_v, rec_a, rec_lam):
     """Index-3 steps of a System holding a BE2D beam in one call (contract in
     :mod:`ancfdae.integrators._index3_steps_numba`)."""
-    index3_steps(be2d_fused, S, P, L, fpar, ipar, out, LU, piv, LUs, pivs, lub, bpiv, W, E, cons, rigid, beam,
-                 element_args)
+    index3_steps(be2d_fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv, W, E, cons, rigid, beam,
+                 element_args, kkt, T_rec, rec_q, rec_v, rec_a, rec_lam)
 
 
 @njit(cache=True)
-def be2d_multipliers(W, ext, q, v, a, lam, cons, rigid, beam, element_args, load_factor):
+def be2d_multipliers(W, ext, q, v, a, lam, cons, rigid, beam, element_args, load_factor, kkt):
     """A System's ``(a, lam)`` at an output time in one call (:func:`ancfdae.integrators._index3_steps_numba.system_multipliers`)."""
-    system_multipliers(be2d_fused, W, ext, q, v, a, lam, cons, rigid, beam, element_args, load_factor)
+    system_multipliers(be2d_fused, W, ext, q, v, a, lam, cons, rigid, beam, element_args, load_factor, kkt)
 
 
 class BE2DCompiled(Kernel):
