@@ -38,7 +38,7 @@ def shear_factors(section, material) -> tuple[float, float]:
 
 def _compiled(element: SQElement) -> Kernel:
     """The compiled kernel object; its module, and numba's loops with it, is imported when selected."""
-    from .kernels_numba import SQCompiled
+    from .sq_kernel import SQCompiled
     return SQCompiled(element)
 
 

@@ -5,7 +5,7 @@ The element's points come in groups, one per distinct quadrature rule
 ``v = B q_e`` (:mod:`.points`) enter the structural (:mod:`.structural`) or
 continuum (:mod:`.continuum`) energy density, and ``B^T g``, ``B^T H B``
 assemble the element force and tangent. The compiled twin is
-:class:`~.kernels_numba.SQCompiled`.
+:class:`~.sq_kernel.SQCompiled`.
 """
 from __future__ import annotations
 

@@ -14,8 +14,8 @@ The fused entry points :func:`sq_structural_fused` and :func:`sq_continuum_fused
 add the gather of the element coordinates and the scatter into the beam's CSR
 data (:mod:`ancfdae.models.beam.assembly_numba`) around the same loops.
 
-Importing this module compiles (or loads) numba code; :mod:`.base` imports it
-only when the compiled kernel is selected.
+Importing this module compiles (or loads) numba code; the kernel object that offers
+these calls to the beam is :class:`.sq_kernel.SQCompiled`.
 
 numba's on-disk cache is keyed on the source file of the cached function
 only, and a cached function holds a compiled copy of the functions it calls:
@@ -32,14 +32,12 @@ import numpy as np
 from numba import njit
 
 from ..beam.assembly_numba import gather_elements, scatter
-from ..element import OnePassKernel
 from .continuum import voigt
 from .continuum_numba import continuum_point
-from .moment_numba import sq_moment_load
 from .structural3d_numba import sq3d_structural_elements
 from .structural_numba import N_JETS, needs_frame, structural_point
 
-__all__ = ["SQCompiled", "compiled_geometry", "sq_structural", "sq_continuum", "sq_structural_fused",
+__all__ = ["compiled_geometry", "sq_structural", "sq_continuum", "sq_structural_fused",
            "sq_continuum_fused"]
 
 _INLINE = dict(cache=True, inline="always", fastmath={"contract"})
@@ -231,54 +229,6 @@ def sq_continuum_fused(q, q_fixed, gather, vec_slot, mat_slot, tangent, r, kdata
     scatter(f, vec_slot, r)
     if tangent:
         scatter(K, mat_slot, kdata)
-
-
-class SQCompiled(OnePassKernel):
-    """The compiled kernel object of SQ2D and SQ3D: :func:`sq_structural` or :func:`sq_continuum`, the
-    compiled dead moment and the fused entry points."""
-
-    name = "numba"
-
-    def _arrays(self, geom):
-        """The compiled kernels' arrays of ``geom`` (:func:`compiled_geometry`), built once per geometry."""
-        arrays = geom.get("_numba")
-        if arrays is None:
-            el = self.element
-            arrays = geom["_numba"] = compiled_geometry(el.formulation, el.dim, len(el._terms), geom)
-        return arrays
-
-    def energy_forces(self, geom: dict, q: np.ndarray, order: int) -> tuple:
-        """As :meth:`.kernels.SQReference.energy_forces`, compiled (the forces are zeros for ``order`` 0)."""
-        q = np.ascontiguousarray(q, dtype=float)
-        if self.element.formulation == "structural":
-            return sq_structural(q, *self._arrays(geom), self.element.dim, order)
-        return sq_continuum(q, *self._arrays(geom), self.element.dim, order)
-
-    def moment_load(self, geom: dict, q: np.ndarray, s: float, moment: np.ndarray, element: int,
-                    tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        """As :meth:`.kernels.SQReference.moment_load`, compiled."""
-        el = self.element
-        f, K = sq_moment_load(np.ascontiguousarray(q, dtype=float), float(s), el.nodes, el.dim,
-                              np.ascontiguousarray(moment, dtype=float), bool(tangent))
-        return f, (K if tangent else None)
-
-    def fused(self, geom: dict) -> tuple:
-        """``(sq_structural_fused or sq_continuum_fused, args)`` (see :meth:`ancfdae.models.Element.fused_kernel`)."""
-        hit = geom.get("_numba_fused")
-        if hit is None:
-            fn = sq_structural_fused if self.element.formulation == "structural" else sq_continuum_fused
-            hit = geom["_numba_fused"] = (fn, tuple(self._arrays(geom)) + (self.element.dim,))
-        return hit
-
-    def fused_projection(self, geom: dict) -> tuple:
-        """``(fn, args)``: the forces at several configurations, projected (``sq3d_structural_projection``,
-        ``sq2d_structural_projection`` or ``sq_continuum_projection`` of :mod:`.projection_numba`; see
-        :meth:`ancfdae.models.beam.stages.StageEvaluator.projection`)."""
-        from . import projection_numba as pn
-        if self.element.formulation == "structural":     # one entry point per dimension (compiled on first use)
-            return (pn.sq3d_structural_projection if self.element.dim == 3 else pn.sq2d_structural_projection,
-                    tuple(self._arrays(geom)))
-        return pn.sq_continuum_projection, tuple(self._arrays(geom)) + (self.element.dim,)
 
 
 def compiled_geometry(formulation: str, dim: int, n_strain: int, geom: dict) -> tuple:

@@ -48,7 +48,7 @@ class SQ2D(SQElement):
     kernel : {"auto", "numba", "numpy"}
         Implementation of the energy, forces, tangent and moment load.
         ``"numba"`` and ``"auto"`` (the default): one compiled loop over
-        elements x points (:class:`~ancfdae.models.shear.kernels_numba.SQCompiled`,
+        elements x points (:class:`~ancfdae.models.shear.sq_kernel.SQCompiled`,
         same results to rounding; the first use compiles, 1-3 minutes on a
         loaded 2-core machine, then loads from the on-disk cache in about a
         second). ``"numpy"``: the vectorised NumPy kernels

@@ -151,7 +151,7 @@ class BE2DReference(Kernel):
 
     The force is ``W_g dg + W_c dc`` and the tangent
     ``W_gg dg dg^T + W_gc (dg dc^T + dc dg^T) + W_cc dc dc^T + W_g d2g + W_c d2c``
-    (module docstring); the compiled twin is :class:`~.be2d_numba.BE2DCompiled`.
+    (module docstring); the compiled twin is :class:`~.be2d_kernel.BE2DCompiled`.
     """
 
     name = "numpy"
@@ -185,7 +185,7 @@ class BE2DReference(Kernel):
 
 def _compiled(element: BE2D) -> Kernel:
     """The compiled kernel object; its module, and numba's loops with it, is imported when selected."""
-    from .be2d_numba import BE2DCompiled
+    from .be2d_kernel import BE2DCompiled
     return BE2DCompiled(element)
 
 
@@ -216,7 +216,7 @@ class BE2D(Element):
     kernel : {"auto", "numba", "numpy"}
         Implementation of :meth:`internal_forces`. ``"numba"`` and ``"auto"``
         (the default): one compiled loop over elements x points
-        (:class:`~.be2d_numba.BE2DCompiled`, same results to rounding; the
+        (:class:`~.be2d_kernel.BE2DCompiled`, same results to rounding; the
         first call compiles, or loads the on-disk cache). ``"numpy"``:
         vectorised NumPy (:class:`BE2DReference`), the reference. Settable
         later through the ``kernel`` attribute.

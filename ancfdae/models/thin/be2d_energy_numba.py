@@ -1,4 +1,4 @@
-"""Compiled BE2D strain energy: the energy of the compiled kernel :class:`.be2d_numba.BE2DCompiled`.
+"""Compiled BE2D strain energy: the energy of the compiled kernel :class:`.be2d_kernel.BE2DCompiled`.
 
 ``U = sum_e sum_p w_p W(g_p, c_p)`` with the densities of chapter Eqs. 82-83 (structural: ``EA/2 (|r'| -
 1 - eps_ref)^2`` at the axial points, ``EI/2 (K - K_ref)^2`` with ``K = c / g`` (Eq. 78) at the bending

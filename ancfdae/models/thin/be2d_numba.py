@@ -5,12 +5,10 @@ The same force and exact tangent as the NumPy reference :class:`.be2d.BE2DRefere
 ``c = (r' x r'').e_z``), computed in one compiled loop over elements x
 quadrature points: on small meshes it removes the per-call overhead of some
 fifty NumPy operations on arrays of a few hundred entries. The tests compare
-the two on random deformed states. :class:`BE2DCompiled` is the kernel object;
-it also offers the fused assembly entry point :func:`be2d_fused` and the strain
-energy of :mod:`.be2d_energy_numba`.
+the two on random deformed states. The kernel object that offers these calls to
+the beam is :class:`.be2d_kernel.BE2DCompiled`.
 
-Importing this module compiles (or loads) numba code; :mod:`.be2d` imports it
-only when the compiled kernel is selected.
+Importing this module compiles (or loads) numba code.
 """
 from __future__ import annotations
 
@@ -22,10 +20,9 @@ from ..beam.iteration_numba import alpha_finish, alpha_update, carry_on
 from ...integrators._alpha_steps_numba import alpha_steps
 from ..beam.static_numba import static_newton
 from ...integrators._index3_steps_numba import index3_steps, system_multipliers
-from ..element import Kernel
-from .be2d_energy_numba import CONTINUUM, STRUCTURAL, be2d_energies, be2d_energy_fused
+from .be2d_energy_numba import CONTINUUM, STRUCTURAL
 
-__all__ = ["BE2DCompiled", "be2d_forces", "be2d_fused", "be2d_alpha_iterations", "be2d_alpha_steps",
+__all__ = ["be2d_forces", "be2d_fused", "be2d_alpha_iterations", "be2d_alpha_steps",
            "be2d_static_newton", "be2d_index3_steps", "be2d_multipliers", "STRUCTURAL", "CONTINUUM"]
 
 
@@ -270,66 +267,3 @@ def be2d_index3_steps(S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv, W
 def be2d_multipliers(W, ext, q, v, a, lam, cons, rigid, beam, element_args, load_factor, kkt):
     """A System's ``(a, lam)`` at an output time in one call (:func:`ancfdae.integrators._index3_steps_numba.system_multipliers`)."""
     system_multipliers(be2d_fused, W, ext, q, v, a, lam, cons, rigid, beam, element_args, load_factor, kkt)
-
-
-class BE2DCompiled(Kernel):
-    """The compiled kernel object of BE2D: :func:`be2d_forces` and the fused entry point :func:`be2d_fused`."""
-
-    name = "numba"
-
-    def _args(self, geom):
-        """The kernel's arguments after ``q``: C-contiguous float copies, made once per geometry."""
-        args = geom.get("_numba")
-        if args is None:
-            el = self.element
-            E, sec = el.material.E, el.section
-            form = STRUCTURAL if el.formulation == "structural" else CONTINUUM
-            args = geom["_numba"] = tuple(np.ascontiguousarray(geom[k], dtype=float)
-                                          for k in ("dN_e", "ddN_e", "w", "eps_ref", "K_ref")) + (
-                geom["n_a"], form, E * sec.A, E, sec.I3, sec.I4)
-        return args
-
-    def internal_forces(self, geom: dict, q: np.ndarray,
-                        tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        """As :meth:`.be2d.BE2DReference.internal_forces`, compiled."""
-        f, K = be2d_forces(np.ascontiguousarray(q, dtype=float), *self._args(geom), bool(tangent))
-        return f, (K if tangent else None)
-
-    def fused(self, geom: dict) -> tuple:
-        """``(be2d_fused, args)``: the fused assembly entry point (see :meth:`ancfdae.models.Element.fused_kernel`)."""
-        return be2d_fused, self._args(geom)
-
-    def fused_projection(self, geom: dict) -> tuple:
-        """``(be2d_projection, args)``: the forces at several configurations, projected (see
-        :meth:`ancfdae.models.beam.stages.StageEvaluator.projection`; :mod:`.be2d_projection_numba`)."""
-        from .be2d_projection_numba import be2d_projection
-        return be2d_projection, self._args(geom)
-
-    def alpha_iterations(self, geom: dict) -> tuple:
-        """``(be2d_alpha_iterations, args)``: compiled Newton iterations (:mod:`ancfdae.models.beam.iteration_numba`)."""
-        return be2d_alpha_iterations, self._args(geom)
-
-    def alpha_steps(self, geom: dict) -> tuple:
-        """``(be2d_alpha_steps, args)``: compiled whole steps (:mod:`ancfdae.integrators._alpha_steps_numba`)."""
-        return be2d_alpha_steps, self._args(geom)
-
-    def static_newton(self, geom: dict) -> tuple:
-        """``(be2d_static_newton, args)``: a load step's static full Newton (:mod:`ancfdae.models.beam.static_numba`)."""
-        return be2d_static_newton, self._args(geom)
-
-    def index3_steps(self, geom: dict) -> tuple:
-        """``(be2d_index3_steps, args)``: whole index-3 steps of a System (:mod:`ancfdae.integrators._index3_steps_numba`)."""
-        return be2d_index3_steps, self._args(geom)
-
-    def multipliers(self, geom: dict) -> tuple:
-        """``(be2d_multipliers, args)``: a System's reactions at an output time (:mod:`ancfdae.system_compiled`)."""
-        return be2d_multipliers, self._args(geom)
-
-    def strain_energy(self, geom: dict, q: np.ndarray) -> np.ndarray:
-        """As :meth:`.be2d.BE2DReference.strain_energy`, compiled (:mod:`.be2d_energy_numba`)."""
-        return be2d_energies(np.ascontiguousarray(q, dtype=float), *self._args(geom))
-
-    def fused_energy(self, geom: dict) -> tuple:
-        """``(be2d_energy_fused, args)``: the beam's strain energy read through its gather (the optional kernel
-        method of :func:`ancfdae.models.beam.potential.beam_potential`)."""
-        return be2d_energy_fused, self._args(geom)
