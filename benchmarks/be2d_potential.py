@@ -10,21 +10,12 @@ per-element entry point ``element.strain_energy`` on element coordinates. Timing
 from __future__ import annotations
 
 import argparse
-import time
 
 import numpy as np
 
 from ancfdae.studies._flying import b2_beam
 
-KERNELS = ("numpy", "numba")
-
-
-def _time_calls(fn, calls: int) -> float:
-    """CPU seconds of the process per call (on a shared machine, less inflated than wall time)."""
-    t0 = time.process_time()
-    for _ in range(calls):
-        fn()
-    return (time.process_time() - t0) / calls
+from ._kernel_timing import interleaved_medians
 
 
 def case(n_elements: int, calls: int, repeats: int) -> dict:
@@ -34,18 +25,7 @@ def case(n_elements: int, calls: int, repeats: int) -> dict:
     q = beam.initial_state()[0] + 1e-3 * np.random.default_rng(0).standard_normal(beam.n_dof)
     qe = beam._element_q(q)
     fns = {"potential": lambda: beam.potential(0.0, q), "strain_energy": lambda: el.strain_energy(beam.geom, qe)}
-    samples = {k: {m: [] for m in fns} for k in KERNELS}
-    for kernel in KERNELS:            # compile / warm up outside the timed loop
-        el.kernel = kernel
-        for fn in fns.values():
-            fn()
-    for _ in range(repeats):
-        for kernel in KERNELS:
-            el.kernel = kernel
-            for m, fn in fns.items():
-                samples[kernel][m].append(_time_calls(fn, calls))
-    el.kernel = "auto"
-    return {k: {m: float(np.median(s)) for m, s in d.items()} for k, d in samples.items()}
+    return interleaved_medians(el, fns, calls, repeats)
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -10,21 +10,12 @@ whole-model ``residual`` and ``jacobian`` of the Beam; and the kernel times per 
 from __future__ import annotations
 
 import argparse
-import time
 
 import numpy as np
 
 from ancfdae.studies.cantilever import build
 
-KERNELS = ("numpy", "numba")
-
-
-def _time_calls(fn, calls: int) -> float:
-    """CPU seconds of the process per call (on a shared machine, less inflated than wall time)."""
-    t0 = time.process_time()
-    for _ in range(calls):
-        fn()
-    return (time.process_time() - t0) / calls
+from ._kernel_timing import KERNELS, interleaved_medians
 
 
 def case(name: str, n_elements: int, calls: int, repeats: int) -> dict:
@@ -42,18 +33,7 @@ def case(name: str, n_elements: int, calls: int, repeats: int) -> dict:
     if not el.mass_is_constant:
         fns["inertia"] = lambda: el.inertia(geom, qe, ve, ae, False)
         fns["inertia+jac"] = lambda: el.inertia(geom, qe, ve, ae, True)
-    samples = {k: {m: [] for m in fns} for k in KERNELS}
-    for kernel in KERNELS:            # compile / warm up outside the timed loop
-        el.kernel = kernel
-        for fn in fns.values():
-            fn()
-    for _ in range(repeats):
-        for kernel in KERNELS:
-            el.kernel = kernel
-            for m, fn in fns.items():
-                samples[kernel][m].append(_time_calls(fn, calls))
-    el.kernel = "auto"
-    out = {k: {m: float(np.median(s)) for m, s in d.items()} for k, d in samples.items()}
+    out = interleaved_medians(el, fns, calls, repeats)
     points = {"f": el.axial_points + el.bending_points}
     points["f+K"] = points["f"]
     if not el.mass_is_constant:
