@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["gather_elements", "scatter", "gather_configurations", "scatter_projection"]
+__all__ = ["gather_elements", "scatter", "gather_configurations", "weigh_into", "scatter_projection"]
 
 
 @njit(cache=True)
@@ -71,6 +71,16 @@ def gather_configurations(Z, q_fixed, gather, e, A, Qe):
         else:
             for l in range(k):
                 Qe[l, j] = q_fixed[g - n]
+
+
+@njit(cache=True, inline="always")
+def weigh_into(out, B, l, x, n):
+    """``out[s, :n] += B[l, s] x[:n]`` for every output ``s``: configuration ``l``'s values weighted into the
+    projections (the projection entry points' one accumulation)."""
+    for s in range(B.shape[1]):
+        w = B[l, s]
+        for j in range(n):
+            out[s, j] += w * x[j]
 
 
 @njit(cache=True, inline="always")

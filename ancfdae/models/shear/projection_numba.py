@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..beam.assembly_numba import gather_configurations, scatter_projection
+from ..beam.assembly_numba import gather_configurations, scatter_projection, weigh_into
 from .kernels_numba import _continuum_element, _shape_table, _structural_element
 from .structural3d_force_numba import N_ROWS, point_force
 from .structural3d_numba import NK, NP, NV, _scatter
@@ -58,10 +58,7 @@ def _sq3d_structural(Z, q_fixed, gather, vec_slot, A, B, out, N, dN, Dw, ref):
                             x += Sb[b, i] * Qe[l, col[b, i] + c]
                         v[3 * b + c] = x
                 point_force(v, Dw[e, p], ref[e, p], SV, SG, eps, sig, g, need_frame)
-                for s in range(r):
-                    w = B[l, s]
-                    for i in range(NV):
-                        gp[s, i] += w * g[i]
+                weigh_into(gp, B, l, g, NV)
             for s in range(r):
                 _scatter(gp[s], H, Sb, col, 5 if need_frame else 2, Y, fe[s], K_row, 1)
         scatter_projection(fe, e, vec_slot, out)
@@ -86,10 +83,7 @@ def _sq2d_structural(Z, q_fixed, gather, vec_slot, A, B, out, N, dN, Dw, ref):
             fl[:] = 0.0
             _structural_element(2, Qe[l], N[e], dN[e], Dw[e], ref[e], fl, K_row, 1, Sb, col, v, g, H,
                                 JV, JG, JH, eps, sig, Jm)
-            for s in range(r):
-                w = B[l, s]
-                for j in range(ne):
-                    fe[s, j] += w * fl[j]
+            weigh_into(fe, B, l, fl, ne)
         scatter_projection(fe, e, vec_slot, out)
 
 
@@ -134,10 +128,7 @@ def _continuum(dim, Z, q_fixed, gather, vec_slot, A, B, out, N, dN, wax, blk, co
             else:
                 _continuum_element(2, Qe[l], N[e], dN[e], wax[e], blk, coef, cnt, ws, Ds, ref[e], vi, vj, fl,
                                    K_row, 1, Sb, col, v, g, H, X, eps, sig, S, Bm, DB, HX)
-            for s in range(r):
-                w = B[l, s]
-                for j in range(ne):
-                    fe[s, j] += w * fl[j]
+            weigh_into(fe, B, l, fl, ne)
         scatter_projection(fe, e, vec_slot, out)
 
 
