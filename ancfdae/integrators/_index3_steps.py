@@ -23,6 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from ancfdae.integrators import _index3_steps_numba as sn
+from ancfdae.integrators._alpha_index3 import EXTRAPOLATE_TOL
 from ancfdae.integrators._linsolve import _Banded
 from ancfdae.integrators._newton import _Factor
 from ancfdae.integrators.driver import GRID_TOL
@@ -65,9 +66,9 @@ class Index3Steps:
         self._fn, self._stepper, self._arrays = arrays.compiled.index3_steps, stepper, arrays
         f = np.zeros(sn.N_FPAR)
         f[[sn.T0, sn.H, sn.T_BOUND, sn.BETA, sn.GAMMA, sn.ALPHA_M, sn.ALPHA_F, sn.TOL, sn.CONTRACTION,
-           sn.GRID_TOL, sn.MSCALE, sn.XTOL, sn.LOAD_FACTOR, sn.FLOOR_FACTOR]] = (
+           sn.GRID_TOL, sn.MSCALE, sn.XTOL, sn.LOAD_FACTOR, sn.FLOOR_FACTOR, sn.EXTRAPOLATE_TOL]] = (
             s.t0, s.h, s.t_bound, s.beta, s.gamma, s.alpha_m, s.alpha_f, o.tol, o.contraction, GRID_TOL,
-            s._mscale, o.xtol, arrays.load_factor, s.FLOOR_ROUNDOFF)
+            s._mscale, o.xtol, arrays.load_factor, s.FLOOR_ROUNDOFF, EXTRAPOLATE_TOL)
         self._fpar = f
         N, (_, kl, ku) = model.n_dof + model.n_constraints, arrays.kkt
         self._AB, self._piv = np.zeros((N, 2 * kl + ku + 1)), np.zeros(N, dtype=np.int64)
@@ -137,11 +138,14 @@ class Index3Steps:
         f = self._fpar.copy()
         f[sn.T], f[sn.T_STOP], f[sn.H_MATRIX], f[sn.ATOL], f[sn.FLOOR] = (s.t, t_stop, s._h_matrix or 0.0, s._atol,
                                                                           s._floor)
-        ipar = np.array((s.n_steps, max_count, newton.options.max_iter, kind, s._h_matrix is not None, kl, ku),
-                        dtype=np.int64)
+        last = s._last
+        ipar = np.array((s.n_steps, max_count, newton.options.max_iter, kind, s._h_matrix is not None, kl, ku,
+                         last is not None, s.predictor != "constant"), dtype=np.int64)
         n, m = s.q.size, s.lam.size
         S, P, L = np.empty((4, n)), np.empty((4, n)), np.empty((2, m))
         S[0], S[1], S[2], S[3], L[0], L[1] = s.q, s.v, s.a, s._ah, s.lam, s.lam
+        if last is not None:   # the predictor's second point
+            f[sn.H_LAST], P[3], L[1] = last
         out = np.zeros(sn.N_OUT, dtype=np.int64)
         a = self._arrays
         rec = (np.empty((T_rec.size, n)), np.empty((T_rec.size, n)), np.empty((T_rec.size, n)),
@@ -174,5 +178,6 @@ class Index3Steps:
         if done:
             s.previous = (float(f[sn.T_PREV]), P[0], P[1], P[2])
             s.t, s.q, s.v, s.a, s._ah, s.lam = float(f[sn.T]), S[0], S[1], S[2], S[3], L[0]
+            s._last = (float(f[sn.H_LAST]), P[3], L[1])
             s.n_steps += done
         return s.step(), done, samples

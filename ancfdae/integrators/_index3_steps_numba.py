@@ -18,7 +18,8 @@ is the Python path's. The entry point::
 
 * ``S`` (4, n): ``q, v, a, ah`` (``ah`` the algorithmic acceleration) at ``fpar[T]`` on entry, the state
   reached on return; ``P`` (4, n) the state before the last step taken; ``L`` (2, m): the multipliers
-  reached and those before the last step.
+  reached and those before the last step. On entry ``P[3]`` and ``L[1]`` are those at the start of the
+  stepper's last step (read only where ``ipar[HAVE_LAST]``: the extrapolating predictor).
 * ``AB, piv``: the band factors of the KKT matrix in band order (``(n + m, 2 kl + ku + 1)``, the layout of
   :func:`~ancfdae.integrators._linsolve_numba.band_factor`; written at each refresh, ``ipar[KIND] = OWN``),
   ``ABs, pivs`` their copy at the start of a step that refreshed; ``lub, bpiv``: LAPACK's banded factors of the
@@ -56,11 +57,12 @@ __all__ = ["index3_steps", "system_multipliers", "kkt_solve"]
 
 # fpar
 T0, H, T, T_BOUND, T_STOP, H_MATRIX, BETA, GAMMA, ALPHA_M, ALPHA_F, TOL, ATOL, FLOOR, CONTRACTION, GRID_TOL, \
-    T_PREV, MSCALE, XTOL, LOAD_FACTOR, FLOOR_FACTOR = range(20)
-N_FPAR = 20
-# ipar
-N_STEPS, MAX_COUNT, MAX_ITER, KIND, HAVE_H, KL, KU = range(7)
-N_IPAR = 7
+    T_PREV, MSCALE, XTOL, LOAD_FACTOR, FLOOR_FACTOR, H_LAST, EXTRAPOLATE_TOL = range(22)
+N_FPAR = 22
+# ipar (HAVE_LAST: P[3] and L[1] hold ah and lam at the start of a last step of size fpar[H_LAST]; EXTRAPOLATE:
+# the predictor of :func:`ancfdae.integrators._alpha_index3.predictor`)
+N_STEPS, MAX_COUNT, MAX_ITER, KIND, HAVE_H, KL, KU, HAVE_LAST, EXTRAPOLATE = range(9)
+N_IPAR = 9
 # ipar[KIND]: no factors, the steps' own band factors (AB, piv), LAPACK's of the Python path (lub, bpiv)
 NONE, OWN, BAND = 0, 1, 2
 # out
@@ -191,6 +193,7 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv,
     n_steps, max_count, max_iter = ipar[N_STEPS], min(ipar[MAX_COUNT], W.shape[0]), ipar[MAX_ITER]
     kind, kl, ku = ipar[KIND], ipar[KL], ipar[KU]
     have_h, h_matrix, floor = ipar[HAVE_H], fpar[H_MATRIX], fpar[FLOOR]
+    have_last, h_last, extrapolate, etol = ipar[HAVE_LAST], fpar[H_LAST], ipar[EXTRAPOLATE], fpar[EXTRAPOLATE_TOL]
     x, r, dx, bx = np.empty(N), np.empty(N), np.empty(N), np.empty(N)
     rbuf, kbuf = np.empty(nb + 1), np.empty(beam[6].size + 1)
     qp, vp, ca = np.empty(n), np.empty(n), np.empty(n)
@@ -216,14 +219,16 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv,
         sm = s * mscale
         c_v = gamma / (beta * hs)
         cx = beta * hs * hs
+        # the predictor (_alpha_index3.predictor): extrapolated from the last step when it had this size
+        extra = extrapolate == 1 and have_last == 1 and abs(h_last - hs) <= etol * hs
         for i in range(n):
             ah0 = S[3, i]
             qp[i] = S[0, i] + hs * S[1, i] + (hs * hs * (0.5 - beta)) * ah0
             vp[i] = S[1, i] + (hs * (1.0 - gamma)) * ah0
             ca[i] = (am * ah0 - af * S[2, i]) / (1.0 - af)
-            x[i] = cx * ah0
+            x[i] = cx * (2.0 * ah0 - P[3, i]) if extra else cx * ah0
         for i in range(m):
-            x[n + i] = L[0, i] / sm
+            x[n + i] = (2.0 * L[0, i] - L[1, i]) / sm if extra else L[0, i] / sm
         # NewtonSolver.solve and _attempt (modified Newton)
         err, q = _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid, beam, eargs,
                            rbuf, kbuf, work)
@@ -309,6 +314,7 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv,
         evals += ev
         jacs += jc
         done += 1
+        have_last, h_last = 1, hs
         t_prev, t = t, t_new
         fpar[T_PREV], fpar[T] = t_prev, t
         tol_t = grid_tol * (t - t_prev)
@@ -329,7 +335,7 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv,
             rec_v[nrec, :] = S[1]
             rec_a[nrec, :] = S[2]
             nrec += 1
-    fpar[FLOOR], fpar[H_MATRIX] = floor, h_matrix
+    fpar[FLOOR], fpar[H_MATRIX], fpar[H_LAST] = floor, h_matrix, h_last
     ipar[KIND], ipar[HAVE_H] = kind, have_h
     out[DONE], out[STATUS], out[ITERATIONS], out[RESIDUALS], out[JACOBIANS], out[RECORDED] = (done, status, iters,
                                                                                            evals, jacs, nrec)

@@ -148,6 +148,22 @@ def _constrained_start(stepper, model, caps, events, t0, q0, v0):
     return consistent_state(model, t0, q0, v0)
 
 
+def _every_step(stepper) -> np.ndarray | None:
+    """The start and every step's end of an initialised fixed-step stepper that takes steps across output times
+    (``steps_sampling``), as output times; None for any other stepper.
+
+    Output at every step (no ``t_eval``) is then the same run as ``t_eval`` on the step grid: the compiled steps
+    record the samples themselves instead of returning to Python after each step (B6, 8 BE2D, h = 1e-4: 0.8 ms a
+    step in Python, ~40 us compiled). The times are those of :meth:`FixedStepIntegrator.next_time`, computed the
+    same way (``t0 + k h``, the last one moved to the end of the run)."""
+    if not getattr(stepper, "fixed_step", False) or getattr(stepper, "steps_sampling", None) is None:
+        return None
+    t0, h, tb = stepper.t0, stepper.h, stepper.t_bound
+    t = t0 + np.arange(1, math.ceil((tb - t0) / h) + 2) * h
+    t[t >= tb - GRID_TOL * h] = tb
+    return np.concatenate(([t0], t[:int(np.searchsorted(t, tb)) + 1]))
+
+
 def _check_max_steps(stepper, t0, tf, max_steps):
     if max_steps is None:
         max_steps = DEFAULT_MAX_STEPS
@@ -272,6 +288,8 @@ def integrate(stepper: Stepper, model: Model, t_span: tuple[float, float], t_eva
             q0, v0, a0 = start.q, start.v, start.a
             stepper.initialize(bound, t0, q0, v0, a0, tf, want_quadrature=bool(rec.monitors), lam0=start.lam)
         rec.start(t0, q0, v0, a0)
+        if t_out is None and not rec.monitors and not hooks and not events:
+            t_out = _every_step(stepper)
         j = 0
         if t_out is None or t_out[0] <= t0:
             rec.sample(t0, q0, v0, a0, state)

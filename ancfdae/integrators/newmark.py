@@ -48,6 +48,7 @@ from ancfdae.integrators._newton_records import CONTRACTION, NewtonOptions
 from ancfdae.integrators.driver import consistent_acceleration
 from ancfdae.integrators.newton_stepper import NewtonStepper
 from ancfdae.integrators.protocol import StepOutcome
+from ancfdae import _validate as validate
 from ancfdae.problem import Model, capabilities
 
 __all__ = ["Newmark", "HHTAlpha", "GeneralizedAlpha"]
@@ -61,6 +62,9 @@ _log = logging.getLogger("ancfdae")
 #: 7.8-8.7 iterations a step at 0.3, 3.6-4.5 at 0.03 (0.12-0.41 refreshes), 26-35 % less CPU; B5 within noise
 #: (``python -m benchmarks.index3_cost --contraction 0.3 0.03``)
 INDEX3_CONTRACTION = 0.03
+#: Newton's start on a constrained model: "auto" and "extrapolate" extrapolate ``(ah, lam)`` linearly from the last
+#: two steps (:func:`ancfdae.integrators._alpha_index3.predictor`), "constant" starts from the current ones
+PREDICTORS = ("auto", "extrapolate", "constant")
 
 
 def _param(name, value, low, high):
@@ -75,9 +79,13 @@ class _AlphaFamily(NewtonStepper):
     order = 2
     handles_constraints = True
 
-    def __init__(self, model, h, beta, gamma, alpha_m, alpha_f, newton):
+    def __init__(self, model, h, beta, gamma, alpha_m, alpha_f, newton, predictor="auto"):
         super().__init__(model, h, newton=newton)
         self.beta, self.gamma, self.alpha_m, self.alpha_f = beta, gamma, alpha_m, alpha_f
+        self.predictor = validate.choice("predictor", predictor, PREDICTORS)
+        if self.predictor == "extrapolate" and "constraints" not in capabilities(model):
+            raise ValueError("`predictor` 'extrapolate' is the index-3 step's (a model with the 'constraints' "
+                             "capability); this model's steps start from a_n: use 'auto' or 'constant'.")
         self._offer = (None, None)   # (model, its compiled_residual), taken at the first step of a run
         self._steps = (None, None)   # (model, its AlphaSteps or Index3Steps or None), made at the first steps_until
 
@@ -90,7 +98,8 @@ class _AlphaFamily(NewtonStepper):
             ``h``, the Newton options and the four parameters of the scheme.
         """
         o = super().options()
-        o.update(beta=self.beta, gamma=self.gamma, alpha_m=self.alpha_m, alpha_f=self.alpha_f)
+        o.update(beta=self.beta, gamma=self.gamma, alpha_m=self.alpha_m, alpha_f=self.alpha_f,
+                 predictor=self.predictor)
         return o
 
     def _setup(self) -> None:
@@ -102,6 +111,7 @@ class _AlphaFamily(NewtonStepper):
         self.newton.choose_contraction(INDEX3_CONTRACTION if self._constrained else CONTRACTION)
         if self._constrained:
             self._ah = self.a.copy()
+            self._last = None   # (h, ah, lam) at the start of the last step: the index-3 predictor's second point
             self._kkt = KKTAssembler()
             self._mscale = mass_scale(self.model.mass(self.q))
             if self.lam is None:
@@ -118,6 +128,8 @@ class _AlphaFamily(NewtonStepper):
         outcome : StepOutcome
             A successful step.
         """
+        if self._constrained:
+            self._last = (outcome.t - self.t, self._ah, self.lam)
         super().accept(outcome)
         if self._constrained:
             self._ah = self._ah_next
@@ -143,6 +155,8 @@ class _AlphaFamily(NewtonStepper):
                 raise FloatingPointError(f"the acceleration before the model event failed: {reason}")
             a = a + (self.a - a_old)
         super().restart(t, q, v, a, model)
+        if self._constrained:
+            self._last = None   # the event changed the state: nothing to extrapolate from
 
     def _step_impl(self, t, h):
         if self._constrained:
@@ -266,14 +280,19 @@ class Newmark(_AlphaFamily):
         In [0, 1]; default 1/2 (no numerical dissipation; order 2 only for
         gamma = 1/2, order 1 otherwise).
     newton : NewtonOptions or dict, optional
+    predictor : {"auto", "extrapolate", "constant"}
+        Newton's start on a constrained model (index 3): "auto" (default) and "extrapolate" take ``ah`` and the
+        multipliers extrapolated linearly from the last two steps of equal size, "constant" the current ones
+        (:func:`ancfdae.integrators._alpha_index3.predictor`). An unconstrained model's steps start from ``a_n``
+        ("auto", "constant"; "extrapolate" raises).
     """
 
     name = "newmark"
 
     def __init__(self, model: Model, h: float, beta: float = 0.25, gamma: float = 0.5, *,
-                 newton: NewtonOptions | dict | None = None) -> None:
+                 newton: NewtonOptions | dict | None = None, predictor: str = "auto") -> None:
         super().__init__(model, h, _param("beta", beta, 0.0, 0.5), _param("gamma", gamma, 0.0, 1.0),
-                         0.0, 0.0, newton)
+                         0.0, 0.0, newton, predictor)
         self.order = 2 if self.gamma == 0.5 else 1
 
 
@@ -291,14 +310,19 @@ class HHTAlpha(_AlphaFamily):
         trapezoidal rule, larger values damp high frequencies more.
     newton : NewtonOptions or dict, optional
         Newton options (default: modified Newton, tolerance 1e-8).
+    predictor : {"auto", "extrapolate", "constant"}
+        Newton's start on a constrained model (index 3): "auto" (default) and "extrapolate" take ``ah`` and the
+        multipliers extrapolated linearly from the last two steps of equal size, "constant" the current ones
+        (:func:`ancfdae.integrators._alpha_index3.predictor`). An unconstrained model's steps start from ``a_n``
+        ("auto", "constant"; "extrapolate" raises).
     """
 
     name = "hht"
 
     def __init__(self, model: Model, h: float, alpha: float = 0.05, *,
-                 newton: NewtonOptions | dict | None = None) -> None:
+                 newton: NewtonOptions | dict | None = None, predictor: str = "auto") -> None:
         alpha = _param("alpha", alpha, 0.0, 1.0 / 3.0)
-        super().__init__(model, h, (1 + alpha) ** 2 / 4, 0.5 + alpha, 0.0, alpha, newton)
+        super().__init__(model, h, (1 + alpha) ** 2 / 4, 0.5 + alpha, 0.0, alpha, newton, predictor)
         self.alpha = alpha
 
     def options(self) -> dict:
@@ -328,15 +352,20 @@ class GeneralizedAlpha(_AlphaFamily):
         (the trapezoidal rule), 0 = asymptotic annihilation.
     newton : NewtonOptions or dict, optional
         Newton options (default: modified Newton, tolerance 1e-8).
+    predictor : {"auto", "extrapolate", "constant"}
+        Newton's start on a constrained model (index 3): "auto" (default) and "extrapolate" take ``ah`` and the
+        multipliers extrapolated linearly from the last two steps of equal size, "constant" the current ones
+        (:func:`ancfdae.integrators._alpha_index3.predictor`). An unconstrained model's steps start from ``a_n``
+        ("auto", "constant"; "extrapolate" raises).
     """
 
     name = "generalized-alpha"
 
     def __init__(self, model: Model, h: float, rho_inf: float = 0.8, *,
-                 newton: NewtonOptions | dict | None = None) -> None:
+                 newton: NewtonOptions | dict | None = None, predictor: str = "auto") -> None:
         rho = _param("rho_inf", rho_inf, 0.0, 1.0)
         am, af = (2 * rho - 1) / (rho + 1), rho / (rho + 1)
-        super().__init__(model, h, (1 - am + af) ** 2 / 4, 0.5 - am + af, am, af, newton)
+        super().__init__(model, h, (1 - am + af) ** 2 / 4, 0.5 - am + af, am, af, newton, predictor)
         self.rho_inf = rho
 
     def options(self) -> dict:

@@ -51,23 +51,37 @@ def _both(system, monkeypatch, t_end, method="generalized-alpha", **kw):
 RTOL = {"q": 1e-11, "v": 1e-8, "a": 1e-5, "lam": 1e-6}
 
 
-def _same(fast, slow):
+#: the extrapolating predictor's first iteration often lands on the residual's round-off floor (B5: 1.1e-6 to
+#: 1.25e-6 N against a floor of 1.19e-6 N), where the two paths' round-off decides a second iteration: counters
+#: within this share (a step counted twice or the predictor missing in one path: 10-30 %)
+COUNTS_RTOL = 0.01
+#: and the states where such a decision differs: B5 (1.5 s, h = 5e-3) q 1.5e-12, v 1.5e-8, a 3e-6, lam 4.6e-8
+RTOL_FLOOR = {"q": 1e-10, "v": 1e-7, "a": 1e-4, "lam": 1e-6}
+
+
+def _same(fast, slow, exact=True):
     for key in COUNTS:
-        assert fast.stats[key] == slow.stats[key], key
+        if exact or key in ("steps", "retries", "failed_solves"):
+            assert fast.stats[key] == slow.stats[key], key
+        else:
+            assert abs(fast.stats[key] - slow.stats[key]) <= COUNTS_RTOL * slow.stats[key], key
     np.testing.assert_array_equal(fast.t, slow.t)
+    rtol = RTOL if exact else RTOL_FLOOR
     for name in ("q", "v", "a", "lam"):
         f, s = getattr(fast, name), getattr(slow, name)
         assert f.shape == s.shape
-        assert np.abs(f - s).max() <= RTOL[name] * np.abs(s).max(), name
+        assert np.abs(f - s).max() <= rtol[name] * np.abs(s).max(), name
 
 
+@pytest.mark.parametrize("predictor", ["constant", "auto"])
 @pytest.mark.parametrize("case, t_end, h, dt", [("b6", 0.03, 1e-4, 1e-3), ("b5", 1.5, 5e-3, 0.02)])
-def test_benchmarks_match_the_python_path(case, t_end, h, dt, monkeypatch):
+def test_benchmarks_match_the_python_path(case, t_end, h, dt, predictor, monkeypatch):
     b = slider_crank("BE2D", 8) if case == "b6" else spinup("BE2D", 8, w_s=4.0)
     t_eval = np.linspace(0.0, t_end, int(round(t_end / dt)) + 1)
-    fast, slow, taken = _both(b.system, monkeypatch, t_end, h=h, rho_inf=0.9, t_eval=t_eval, newton={"tol": 1e-8})
+    fast, slow, taken = _both(b.system, monkeypatch, t_end, h=h, rho_inf=0.9, t_eval=t_eval, newton={"tol": 1e-8},
+                              predictor=predictor)
     assert fast.status == slow.status == "success"
-    _same(fast, slow)
+    _same(fast, slow, exact=predictor == "constant")
     # every step but the last of each compiled call was taken in it, and the calls ran across output times (their
     # samples recorded inside: same times, states and multipliers as the driver's)
     assert sum(taken) == fast.stats["steps"] - len(taken)
@@ -88,6 +102,21 @@ def _loaded(dead=True, force=lambda t: np.cos(20 * t), angle=lambda t: (np.array
                        angle=angle)
     return System([beam, body], [drive, Spherical((beam, -1), (body, (0.0, 0.0)))])
 
+
+
+@pytest.mark.parametrize("case, t_end, h", [("b6", 0.01025, 1e-4), ("b5", 0.5, 5e-3)])
+def test_output_at_every_step_runs_across_the_steps(case, t_end, h, monkeypatch):
+    """No ``t_eval``: output at every step, from compiled calls that run across the steps (the defect: the driver
+    stepping in Python whenever it records every step, 0.8 ms a step on B6 instead of ~40 us); the times are the
+    step grid (B6: the last step shortened to end at ``t_end``) and the samples those of the Python path."""
+    b = slider_crank("BE2D", 8) if case == "b6" else spinup("BE2D", 8, w_s=4.0)
+    fast, slow, taken = _both(b.system, monkeypatch, t_end, h=h, rho_inf=0.9, newton={"tol": 1e-8})
+    assert fast.status == slow.status == "success"
+    _same(fast, slow, exact=False)
+    steps = fast.stats["steps"]
+    assert fast.t.size == steps + 1 and fast.t[-1] == t_end
+    np.testing.assert_allclose(np.diff(fast.t[:-1]), h, rtol=1e-9)
+    assert sum(taken) == steps - len(taken) and len(taken) < steps / 10
 
 @pytest.mark.parametrize("dead, method, opts", [(True, "generalized-alpha", {"rho_inf": 0.8}),
                                                 (False, "generalized-alpha", {"rho_inf": 0.8}),
