@@ -20,7 +20,8 @@
     the ratio at equal accuracy: Lobatto IIIA-3 at ``--h``, every ``--methods`` label (default energy-collocation)
     at ``--h`` and at a second step aimed by order 4 at Lobatto's eps_T (at least 2 % apart); eps_T against a
     reference run (``--ref-method`` at ``--h-ref``, default ``--h`` / 8); CPU medians of ``--reps`` interleaved
-    runs; the method's CPU at Lobatto's eps_T log-log interpolated between its two steps; the load average.
+    runs; the method's CPU at Lobatto's eps_T log-log interpolated between its two steps (also printed: its cost per
+    step at ``--h`` times the steps at the interpolated step, and the ratio at equal step); the load average.
 ``python -m benchmarks.energy_collocation stages [--problem B3-8] [--h 1e-2] [--t-end 10]``
     the energy's spread after the load against the number of silent stages ``k`` (with the default energy defect:
     for a non-polynomial potential the potential's own, which keeps the energy whatever ``k``).
@@ -293,11 +294,11 @@ def equal(a):
         w = (np.log(e_l) - np.log(e1)) / (np.log(e2) - np.log(e1))
         c_eq = float(np.exp(np.log(c1) + w * (np.log(c2) - np.log(c1))))
         h_eq = float(np.exp(np.log(h1) + w * (np.log(h2) - np.log(h1))))    # the step with Lobatto's eps_T
-        c_h = float(np.median(cpu[m, a.h])) * a.h / h_eq                       # per-step cost as at h
+        c_h = float(np.median(cpu[m, a.h])) * a.h / h_eq        # the cost per step at h, times the steps at h_eq
         print(f"{m}: h = {h1:g} eps_T {e1:.3e} CPU {c1:.3f} s; h = {h2:g} eps_T {e2:.3e} CPU {c2:.3f} s; "
-              f"at Lobatto's eps_T{'' if 0.0 <= w <= 1.0 else ' (extrapolated)'} h = {h_eq:.5g}, CPU {c_eq:.3f} s: "
-              f"ratio at equal eps_T {c_eq / lo:.3f}, with the cost per step at h {c_h / lo:.3f} "
-              f"(at equal h {float(np.median(cpu[m, a.h])) / lo:.3f})", flush=True)
+              f"Lobatto's eps_T at h = {h_eq:.5g}{'' if 0.0 <= w <= 1.0 else ' (extrapolated)'}: CPU {c_eq:.3f} s, "
+              f"ratio at equal eps_T {c_eq / lo:.3f} (with the cost per step at h {c_h / lo:.3f}; at equal h "
+              f"{float(np.median(cpu[m, a.h])) / lo:.3f})", flush=True)
 
 
 def stages(a):
