@@ -55,7 +55,7 @@ class VelocityCorrection:
         generators = getattr(model, "symmetry_generators", None)
         if generators is not None:
             T = np.asarray(generators()[0], dtype=float).reshape(M.shape[0], -1)
-        M = sp.csr_matrix(M)
+        M = _nonzeros(M)
         self._M = (M.indptr, M.indices, M.data)     # M v compiled: scipy's product costs 20-30 us to call
         self._T = np.ascontiguousarray(T, dtype=float)
         self._MT = np.ascontiguousarray(M @ T, dtype=float) if T.shape[1] else self._T
@@ -138,7 +138,7 @@ class PotentialDefect:
     """
 
     def __init__(self, model, M, loads) -> None:
-        M = sp.csr_matrix(M)
+        M = _nonzeros(M)
         self._model, self._M = model, (M.data, M.indptr, M.indices)
         self._WdT, self._b = np.ascontiguousarray(loads.Wd.T), np.ascontiguousarray(loads.b)
         self._last = (None, 0.0)          # (q1, P(q1)) of the last call: P(q0) of the next step
@@ -155,6 +155,14 @@ class PotentialDefect:
         self._last = (q1, P1)
         dT, W = kinetic_work(*self._M, v0, v1, np.ascontiguousarray(F, dtype=float), Y, self._WdT, self._b, h)
         return dT + (P1 - P0) - W
+
+
+def _nonzeros(M) -> sp.csr_matrix:
+    """``M`` as a CSR copy without its stored zeros: a beam's mass keeps the stiffness' pattern (B3, 16 SQ3D: 1161
+    nonzeros of 10449 stored entries), and the products here run once a step over what is stored."""
+    M = sp.csr_matrix(M, dtype=float, copy=True)
+    M.eliminate_zeros()
+    return M
 
 
 def energy_defect(Y: np.ndarray, R: np.ndarray, X: np.ndarray, hv: np.ndarray) -> float:
