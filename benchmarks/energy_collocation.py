@@ -16,6 +16,12 @@
     of ``--reps`` runs of each, interleaved in one process, and the median of the per-repetition ratios (equal h is
     equal accuracy: see ``wp``). ``energy-collocation-k5-rule``: the defaults before the potential's defect (k = 5
     for smooth potentials, the rule's defect, refresh at rate 0.3).
+``python -m benchmarks.energy_collocation equal --problem B3-8 [--h 5e-3] [--reps 5] [--methods ...]``
+    the ratio at equal accuracy: Lobatto IIIA-3 at ``--h``, every ``--methods`` label (default energy-collocation)
+    at ``--h`` and at a second step aimed by order 4 at Lobatto's eps_T (at least 2 % apart); eps_T against a
+    reference run (``--ref-method`` at ``--h-ref``, default ``--h`` / 8); CPU medians of ``--reps`` interleaved
+    runs; the method's CPU at Lobatto's eps_T log-log interpolated between its two steps (also printed: its cost per
+    step at ``--h`` times the steps at the interpolated step, and the ratio at equal step); the load average.
 ``python -m benchmarks.energy_collocation stages [--problem B3-8] [--h 1e-2] [--t-end 10]``
     the energy's spread after the load against the number of silent stages ``k`` (with the default energy defect:
     for a non-polynomial potential the potential's own, which keeps the energy whatever ``k``).
@@ -233,6 +239,68 @@ def ratio(a):
               f"{ec:.2f} s, ratio {ec / lo:.2f} (median of the {a.reps} pairs' ratios {pairs:.2f})")
 
 
+def _timed(build, label, h, t_end):
+    """One run of ``label`` at ``h``: (CPU s, tip samples every DT_OUT as run_one's record, it/step, LU/step)."""
+    model = build()
+    t_eval = np.round(np.arange(0.0, t_end + 1e-9, DT_OUT), 10)
+    c0 = time.process_time()
+    res = simulate(model, (0.0, t_end), t_eval=t_eval, monitors=[EnergyMonitor()], **method_of(label, model, h))
+    cpu = time.process_time() - c0
+    if not res.success:
+        raise SystemExit(f"{label} at h = {h:g} failed: {res.message}")
+    st = res.stats
+    return cpu, dict(t=res.t.tolist(), tip=[model.position(q, 0.0).tolist() for q in res.q]), \
+        st["newton_iterations"] / st["steps"], st["factorizations"] / st["steps"]
+
+
+def equal(a):
+    """Ratio to Lobatto IIIA-3 at equal eps_T (module docstring); every run interleaved, medians."""
+    import os
+    build = PROBLEMS[a.problem][0]
+    labels = [m for m in (a.methods or ["energy-collocation"]) if m != "lobatto3"]
+    for m in ["lobatto3"] + labels:                              # compile before timing
+        model = build()
+        simulate(model, (0.0, 0.05), **method_of(m, model, a.h), monitors=[EnergyMonitor()])
+    h_ref = a.h_ref or a.h / 8
+    ref = run_one(a.problem, a.ref_method, h_ref, a.t_end, a.out)
+    load = [os.getloadavg()[0]]
+    cpu_l, run, its, lus = _timed(build, "lobatto3", a.h, a.t_end)
+    e_l = eps(run, ref)
+    print(f"{a.problem} [0, {a.t_end:g}] s, reference {a.ref_method} h = {h_ref:g}; lobatto3 h = {a.h:g}: eps_T "
+          f"{e_l:.4e}, {its:.2f} it/step, {lus:.3f} LU/step", flush=True)
+    steps = {}
+    for m in labels:                                             # the second step, aimed at Lobatto's eps_T
+        cpu, run, its, lus = _timed(build, m, a.h, a.t_end)
+        e = eps(run, ref)
+        f = min(max((e_l / e) ** 0.25, 0.8), 1.25)
+        f = f if abs(f - 1.0) >= 0.02 else (0.98 if f < 1.0 else 1.02)
+        h2 = float(f"{a.h * f:.4g}")
+        steps[m] = {a.h: e}
+        steps[m][h2] = eps(_timed(build, m, h2, a.t_end)[1], ref)
+        print(f"{m}: eps_T {e:.4e} at h = {a.h:g} ({its:.2f} it/step, {lus:.3f} LU/step), "
+              f"{steps[m][h2]:.4e} at h = {h2:g}", flush=True)
+    cpu = {("lobatto3", a.h): []}
+    cpu.update({(m, h): [] for m in labels for h in steps[m]})
+    for _ in range(a.reps):
+        for key in cpu:
+            cpu[key].append(_timed(build, key[0], key[1], a.t_end)[0])
+        load.append(os.getloadavg()[0])
+    lo = float(np.median(cpu["lobatto3", a.h]))
+    print(f"load average (1 min) during the runs: {min(load):.2f}-{max(load):.2f}; CPU medians of {a.reps} runs")
+    print(f"lobatto3 h = {a.h:g}: eps_T {e_l:.3e}, CPU {lo:.3f} s")
+    for m in labels:
+        (h1, e1), (h2, e2) = sorted(steps[m].items(), reverse=True)
+        c1, c2 = float(np.median(cpu[m, h1])), float(np.median(cpu[m, h2]))
+        w = (np.log(e_l) - np.log(e1)) / (np.log(e2) - np.log(e1))
+        c_eq = float(np.exp(np.log(c1) + w * (np.log(c2) - np.log(c1))))
+        h_eq = float(np.exp(np.log(h1) + w * (np.log(h2) - np.log(h1))))    # the step with Lobatto's eps_T
+        c_h = float(np.median(cpu[m, a.h])) * a.h / h_eq        # the cost per step at h, times the steps at h_eq
+        print(f"{m}: h = {h1:g} eps_T {e1:.3e} CPU {c1:.3f} s; h = {h2:g} eps_T {e2:.3e} CPU {c2:.3f} s; "
+              f"Lobatto's eps_T at h = {h_eq:.5g}{'' if 0.0 <= w <= 1.0 else ' (extrapolated)'}: CPU {c_eq:.3f} s, "
+              f"ratio at equal eps_T {c_eq / lo:.3f} (with the cost per step at h {c_h / lo:.3f}; at equal h "
+              f"{float(np.median(cpu[m, a.h])) / lo:.3f})", flush=True)
+
+
 def stages(a):
     for k in a.k:
         r = run_one(a.problem, f"energy-collocation-k{k}", a.h, a.t_end, a.out)
@@ -242,7 +310,7 @@ def stages(a):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("what", choices=("wp", "long", "stages", "ratio"))
+    ap.add_argument("what", choices=("wp", "long", "stages", "ratio", "equal"))
     ap.add_argument("--problem", default="B2-4", choices=tuple(PROBLEMS))
     ap.add_argument("--methods", nargs="+", default=None)
     ap.add_argument("--t-end", type=float, default=None)
@@ -262,7 +330,7 @@ def main(argv=None):
     a = ap.parse_args(argv)
     if a.t_end is None:
         a.t_end = 4.0 if a.problem.startswith("B2") else 5.0
-    {"wp": work_precision, "long": long_runs, "stages": stages, "ratio": ratio}[a.what](a)
+    {"wp": work_precision, "long": long_runs, "stages": stages, "ratio": ratio, "equal": equal}[a.what](a)
 
 
 if __name__ == "__main__":

@@ -22,7 +22,8 @@ __all__ = ["hbvm_options", "SMOOTH_SILENT_STAGES", "CORRECTED_SILENT_STAGES", "E
 #: at k = 5, 9.0e-14 at k = 6).
 SMOOTH_SILENT_STAGES = 5
 #: Silent stages for a non-polynomial potential with ``energy_defect="potential"``: k then sets the accuracy alone
-#: (B3 8 SQ3D, h = 5 ms: eps_T 2.93e-6 at k = 4 and 5, 3.10e-6 at k = 3; docs/energy_momentum.md).
+#: (B3 8 SQ3D, h = 5 ms: eps_T 2.93e-6 at k = 4 and 5, 3.10e-6 at k = 3; B3-16 2.89e-6 / 3.01e-6 at k = 4 / 3, B2
+#: equal; at equal eps_T k = 3 is no cheaper on any of the four problems: docs/energy_momentum.md).
 CORRECTED_SILENT_STAGES = 4
 ENERGY_CORRECTIONS = ("velocity", "newton")
 ENERGY_DEFECTS = ("rule", "potential")

@@ -57,7 +57,6 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from ancfdae import _validate as validate
 from ancfdae.kkt import KKTAssembler
@@ -71,6 +70,7 @@ from ancfdae.integrators._hbvm_matrix import ExactMatrix, _SplitMatrix
 from ancfdae.integrators._hbvm_options import (CORRECTED_SILENT_STAGES, ENERGY_CORRECTIONS, ENERGY_DEFECTS,
                                                SMOOTH_SILENT_STAGES, hbvm_options)
 from ancfdae.integrators._hbvm_numba import stage_residual
+from ancfdae.integrators._linsolve import factorize
 from ancfdae.integrators._newton_records import NewtonOptions
 from ancfdae.integrators._potential_split import require_potential_model, require_potential_split
 from ancfdae.integrators.energy_momentum import DEFAULT_NEWTON
@@ -148,6 +148,7 @@ class EnergyCollocation(NewtonStepper):
         self._exact_matrix = ExactMatrix(self._co, self._loads)
         co = self._co                                # the rules' matrices as the step uses them, formed once
         self._WqT, self._WlT, self._BPT = co.Wq.T.copy(), self._loads.Wq.T.copy(), co.BP.T.copy()
+        self._BlT, self._eye = self._loads.BP.T.copy(), np.eye(_S)
         self._A = np.vstack([np.ones(k), co.c, self._WqT])     # sigma_l = [q0, h v0, Y] @ A[:, l]
 
     def options(self) -> dict:
@@ -179,7 +180,9 @@ class EnergyCollocation(NewtonStepper):
         # singular (a lamina's axis director carries no mass), its accelerations come from the saddle-point
         # (KKT) system, regular on the constraint manifold.
         constrained = "constraints" in capabilities(m)
-        self._Mlu = None if constrained else spla.splu(sp.csc_matrix(self._M))
+        # The shared factorisation (banded LAPACK for a beam's banded M): a SuperLU solve costs 30-140 us a call on
+        # B3 against a few us, once per step.
+        self._Mlu = None if constrained else factorize(self._M)
         self._kkt_out = KKTAssembler() if constrained else None
         z = np.zeros(self.n_dof)
         self._Mcsr = sp.csr_matrix(m.jacobian(self.t, self.q, z, z).M)   # the mass on the stiffness' pattern
@@ -206,7 +209,7 @@ class EnergyCollocation(NewtonStepper):
 
     def _force_terms(self, t0, h):
         """:meth:`_forces` of the step from ``(t0, q, v)`` as a function of ``Y`` alone (see :meth:`_stage_values`)."""
-        values, BlT = self._stage_values(t0, h), self._loads.BP.T.copy()
+        values, BlT = self._stage_values(t0, h), self._BlT
 
         def forces(Y):
             G, F = values(Y)
@@ -225,7 +228,7 @@ class EnergyCollocation(NewtonStepper):
         base_l = self.q[:, None] + np.outer(h * self.v, ld.c)
         WqT, WlT, BPT = self._WqT, self._WlT, self._BPT
         gradient, load = m.potential_gradient, m.nonconservative_force
-        projection, stages = self._projection, self._stages
+        projection, stages, n = self._projection, self._stages, self.n_dof
         if projection:
             Z = np.empty((self.n_dof, 2 + _S))
             Z[:, 0], Z[:, 1] = self.q, h * self.v
@@ -245,7 +248,10 @@ class EnergyCollocation(NewtonStepper):
                     G = np.column_stack([gradient(t, Q[:, l], False)[0] for l, t in enumerate(ts)])
                 G = G @ BPT
             Q = base_l + Y @ WlT
-            return G, np.column_stack([load(t, Q[:, j], False)[0] for j, t in enumerate(tl)])
+            F = np.empty((n, _S))       # filled column by column: np.column_stack costs ~4 us a call
+            for j in range(_S):
+                F[:, j] = load(tl[j], Q[:, j], False)[0]
+            return G, F
 
         return values
 
@@ -274,7 +280,7 @@ class EnergyCollocation(NewtonStepper):
         ih2 = 1.0 / (h * h)
         zn = np.zeros(n)
 
-        values, eye, BlT = self._stage_values(t0, h), np.eye(_S), self._loads.BP.T.copy()
+        values, eye, BlT = self._stage_values(t0, h), self._eye, self._BlT
         mass = (self._M_nz.data, self._M_nz.indptr, self._M_nz.indices)
 
         def residual(x):      # M Y / h^2 + G - F BL^T in one compiled call (G projected already)
@@ -292,8 +298,9 @@ class EnergyCollocation(NewtonStepper):
                 blk = model.jacobian(t0 + 0.5 * h, qm, zn, zn)
                 if blk.same_pattern:
                     K = blk.K
-                    blk = JacobianBlocks(K, sp.csr_matrix((np.zeros_like(K.data), K.indices, K.indptr),
-                                                          shape=K.shape), blk.M, True)
+                    if blk.D.data.any():      # the scheme has no velocity term; an undamped model's D is zero already
+                        blk = JacobianBlocks(K, sp.csr_matrix((np.zeros_like(K.data), K.indices, K.indptr),
+                                                              shape=K.shape), blk.M, True)
                     return _SplitMatrix(blk, h, co.X), self.floor_of(K, qm)
             return self._exact(t0, h, Y)
 

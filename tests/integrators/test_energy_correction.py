@@ -45,6 +45,30 @@ def test_correction_removes_the_given_defects_exactly():
     assert VelocityCorrection(chain, Mc)(h, v, v, 1.01 * MAX_SCALING * kc) is None
 
 
+def test_compiled_correction_equals_the_numpy_reference():
+    """``VelocityCorrection`` (one compiled call) against its NumPy ``reference`` to a few ulp: with translations
+    (SQ3D, free), without (spring chain), a defect refused (None from both), at rest with and without a defect.
+
+    Catches: a kernel that drifts from the reference (a sign, the momentum's translation not added to ``M v1``,
+    the refusal or the at-rest branch returning something else).
+    """
+    rng = np.random.default_rng(11)
+    h = 1e-2
+    for model in (b3("SQ3D", 2), SpringChain()):
+        M = model.mass(None)
+        vc = VelocityCorrection(model, M)
+        v1, R0 = rng.standard_normal(model.n_dof), rng.standard_normal(model.n_dof)
+        kin = 0.5 * v1 @ (M @ v1)
+        for D in (1e-3 * kin, -2e-6 * kin, 0.0):
+            got, want = vc(h, v1, R0, D), vc.reference(h, v1, R0, D)
+            assert np.abs(got - want).max() <= 1e-14 * np.abs(want).max(), D
+        assert vc(h, v1, R0, 1.01 * MAX_SCALING * kin) is None and vc.reference(h, v1, R0, 1.01 * MAX_SCALING * kin) is None
+    beam = b3("SQ3D", 2)
+    vc, z = VelocityCorrection(beam, beam.mass(None)), np.zeros(beam.n_dof)     # at rest: nothing to scale
+    assert np.array_equal(vc(h, z, z, 0.0), vc.reference(h, z, z, 0.0)) and not vc(h, z, z, 0.0).any()
+    assert vc(h, z, z, 1e-9) is None and vc.reference(h, z, z, 1e-9) is None
+
+
 class _Uncorrected(EnergyCollocation):
     """The velocity correction switched off: Newton's tolerance alone decides (the bug this file guards)."""
 
