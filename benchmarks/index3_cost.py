@@ -51,7 +51,7 @@ def _pieces_loop(which, reps, AB, AB0, piv, x, q, s, sm, W3, ext, cons, rigid, b
     mwork = kn.multiplier_work(n, m, nb, AB.shape[1], cons[14].size)
     for _ in range(reps):
         if which == 0:
-            sn._residual(be2d_fused, x, r, n, m, q, zero, zero, 1.0, s, sm, w, ext, 1.0, cons, rigid, beam, eargs,
+            sn._residual(be2d_fused, x, r, n, m, q, zero, s, sm, w, ext, 1.0, cons, rigid, beam, eargs,
                          rbuf, kbuf, work)
         elif which == 1:
             kn.kkt_solve(AB, piv, kkt, x, d, b)

@@ -45,8 +45,9 @@ def rigid_residual(r, q, a, w, rigid, f, ma):
     """``r_i = (M a)_i - f_i(t, q) - f_g,i`` on the rigid bodies' coordinates (``RigidBody.residual``); ``f``,
     ``ma``: work arrays of ``r``'s size."""
     ridx, mi, mj, mv, grav, fvec, fcol, ci, cj, cv, ccol = rigid
-    f[:] = 0.0
-    ma[:] = 0.0
+    for i in ridx:   # every entry below is on a rigid body's coordinates
+        f[i] = 0.0
+        ma[i] = 0.0
     for k in range(fcol.size):
         s = w[fcol[k]]
         for i in ridx:

@@ -75,16 +75,16 @@ STOPPED, NEEDS_PYTHON = 0, 1
 
 
 @njit(inline="always")
-def _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid, beam, eargs, rbuf, kbuf, work):
+def _residual(fused, x, r, n, m, qp, ca, s, sm, w, ext, lf, cons, rigid, beam, eargs, rbuf, kbuf, work):
     """The step's residual ``[r(t1, q1, v1, a1) + G^T lam; sm g]`` at ``x`` into ``r``; returns ``(max|r|, q1)``
-    (``q1`` in the work arrays ``work = (q, v, a, lam, g, f, f2, ma)``, overwritten by the next call)."""
+    (``q1`` in the work arrays ``work = (q, v, a, lam, g, f, f2, ma)``, overwritten by the next call). ``v1`` is
+    not formed: neither the fused beam kernels nor the rigid bodies depend on it (no damping)."""
     ob, nb, q_fixed, gather, vec_slot, mat_slot = beam[:6]
     mr_data, mr_indptr, mr_indices = beam[9:12]   # the mass without its stored zeros, as the Python path's
     q, v, a, lam, g, f, f2, ma = work
     for i in range(n):
         y = x[i]
         q[i] = qp[i] + y
-        v[i] = vp[i] + c_v * y
         a[i] = s * y + ca[i]
     for i in range(m):
         lam[i] = sm * x[n + i]
@@ -151,7 +151,7 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv,
         for i in range(m):
             x[n + i] = L[0, i] / sm
         # NewtonSolver.solve and _attempt (modified Newton)
-        err, q = _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid, beam, eargs,
+        err, q = _residual(fused, x, r, n, m, qp, ca, s, sm, w, ext, lf, cons, rigid, beam, eargs,
                            rbuf, kbuf, work)
         its, ev, jc, saved = 0, 1, 0, False
         ok = np.isfinite(err)
@@ -186,7 +186,7 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv,
                     break
                 for i in range(N):
                     x[i] = x[i] - dx[i]
-                err_new, q = _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid, beam,
+                err_new, q = _residual(fused, x, r, n, m, qp, ca, s, sm, w, ext, lf, cons, rigid, beam,
                                        eargs, rbuf, kbuf, work)
                 ev += 1
                 if not np.isfinite(err_new):
