@@ -66,7 +66,7 @@ def _pieces_loop(which, reps, AB, AB0, piv, x, q, s, sm, W3, ext, cons, rigid, b
             AB[:, :] = AB0
         else:
             kn.system_multipliers(be2d_fused, W3, ext, q, zero, a_out, lam_out, cons, rigid, beam, eargs, 1.0, kkt,
-                                  mwork)
+                                  mwork, np.empty(0))
 
 
 def _best(which, *args):

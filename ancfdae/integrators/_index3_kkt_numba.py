@@ -106,12 +106,13 @@ def multiplier_work(n, m, nb, width, ng):
 
 
 @njit(inline="always")
-def system_multipliers(fused, W, ext, q, v, a_out, lam_out, cons, rigid, beam, eargs, lf, kkt, work):
+def system_multipliers(fused, W, ext, q, v, a_out, lam_out, cons, rigid, beam, eargs, lf, kkt, work, force):
     """``(a, lam)`` from ``[[M, G^T], [G, 0]] [a; lam] = [-r(t, q, v, 0); gamma]``
     (:func:`ancfdae.constrained.multipliers`) into ``a_out``, ``lam_out``: ``W`` (3, nw) the time weights at ``t``
     and their derivatives, ``ext`` the beam's external force at ``t``, ``lf`` its load factor, ``work`` from
-    :func:`multiplier_work`; the matrix in the band order ``kkt`` (its pattern is in the steps' KKT pattern); a
-    singular matrix gives non-finite values."""
+    :func:`multiplier_work`, ``force`` the beam's fused force at ``q`` when the caller has it (the steps' last
+    residual was at ``q``), else empty; the matrix in the band order ``kkt`` (its pattern is in the steps' KKT
+    pattern); a singular matrix gives non-finite values."""
     n, m = q.size, lam_out.size
     ob, nb, q_fixed, gather, vec_slot, mat_slot, m_data = beam[:7]
     mr_data, mr_indptr, mr_indices = beam[9:12]
@@ -119,12 +120,14 @@ def system_multipliers(fused, W, ext, q, v, a_out, lam_out, cons, rigid, beam, e
     mv = rigid[3]
     at_k, at_m, at_g, at_gt = kkt[3], kkt[4], kkt[7], kkt[8]
     AB, piv, r, rhs, xs, bs, rbuf, kbuf, zero, f2, ma, gt, gamma, gdata = work
-    fused(q[ob:ob + nb], q_fixed, gather, vec_slot, mat_slot, False, rbuf, kbuf, *eargs)
-    finish_residual(rbuf, mr_data, mr_indptr, mr_indices, zero[ob:ob + nb], lf, ext)
+    if force.size == 0:
+        fused(q[ob:ob + nb], q_fixed, gather, vec_slot, mat_slot, False, rbuf, kbuf, *eargs)
+        force = rbuf
     r[:] = 0.0
-    rigid_residual(r, q, zero, W[0], rigid, f2, ma)
     for i in range(nb):
-        r[ob + i] = rbuf[i]
+        r[ob + i] = force[i]
+    finish_residual(r[ob:ob + nb], mr_data, mr_indptr, mr_indices, zero[ob:ob + nb], lf, ext)
+    rigid_residual(r, q, zero, W[0], rigid, f2, ma)
     _rates(W[1], W[2], lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa, q, v, gt, gamma)
     f = AB.reshape(-1)
     f[:] = 0.0

@@ -77,8 +77,9 @@ STOPPED, NEEDS_PYTHON = 0, 1
 @njit(inline="always")
 def _residual(fused, x, r, n, m, qp, ca, s, sm, w, ext, lf, cons, rigid, beam, eargs, rbuf, kbuf, work):
     """The step's residual ``[r(t1, q1, v1, a1) + G^T lam; sm g]`` at ``x`` into ``r``; returns ``(max|r|, q1)``
-    (``q1`` in the work arrays ``work = (q, v, a, lam, g, f, f2, ma)``, overwritten by the next call). ``v1`` is
-    not formed: neither the fused beam kernels nor the rigid bodies depend on it (no damping)."""
+    (``q1`` in the work arrays ``work = (q, v, a, lam, g, f, f2, ma)``, overwritten by the next call; ``rbuf`` the
+    beam's force at ``q1``). ``v1`` is not formed: neither the fused beam kernels nor the rigid bodies depend on it
+    (no damping)."""
     ob, nb, q_fixed, gather, vec_slot, mat_slot = beam[:6]
     mr_data, mr_indptr, mr_indices = beam[9:12]   # the mass without its stored zeros, as the Python path's
     q, v, a, lam, g, f, f2, ma = work
@@ -89,10 +90,10 @@ def _residual(fused, x, r, n, m, qp, ca, s, sm, w, ext, lf, cons, rigid, beam, e
     for i in range(m):
         lam[i] = sm * x[n + i]
     fused(q[ob:ob + nb], q_fixed, gather, vec_slot, mat_slot, False, rbuf, kbuf, *eargs)
-    finish_residual(rbuf, mr_data, mr_indptr, mr_indices, a[ob:ob + nb], lf, ext)
-    rigid_residual(r, q, a, w, rigid, f2, ma)
-    for i in range(nb):
+    for i in range(nb):   # rbuf keeps the beam's force: the reactions at an output time reuse it
         r[ob + i] = rbuf[i]
+    finish_residual(r[ob:ob + nb], mr_data, mr_indptr, mr_indices, a[ob:ob + nb], lf, ext)
+    rigid_residual(r, q, a, w, rigid, f2, ma)
     lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa = cons[:11]
     _g_force(w, lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa, q, lam, g, f)
     for i in range(n):
@@ -246,8 +247,9 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv,
             if abs(T_rec[nrec] - t) > tol_t:   # inside the step: the driver interpolates
                 status = STOPPED
                 break
+            # the last residual was at the accepted state: rbuf holds the beam's force at S[0]
             system_multipliers(fused, W[wi], ext, S[0], S[1], a_scratch, rec_lam[nrec], cons, rigid, beam, eargs, lf,
-                               kkt, mwork)
+                               kkt, mwork, rbuf)
             if not np.isfinite(max_abs(rec_lam[nrec])):   # the driver's solve reports it
                 status = STOPPED
                 break

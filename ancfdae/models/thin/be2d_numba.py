@@ -268,4 +268,5 @@ def be2d_index3_steps(S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv, W
 def be2d_multipliers(W, ext, q, v, a, lam, cons, rigid, beam, element_args, load_factor, kkt):
     """A System's ``(a, lam)`` at an output time in one call (:func:`ancfdae.integrators._index3_kkt_numba.system_multipliers`)."""
     work = multiplier_work(q.size, lam.size, beam[1], 2 * kkt[1] + kkt[2] + 1, cons[14].size)
-    system_multipliers(be2d_fused, W, ext, q, v, a, lam, cons, rigid, beam, element_args, load_factor, kkt, work)
+    system_multipliers(be2d_fused, W, ext, q, v, a, lam, cons, rigid, beam, element_args, load_factor, kkt, work,
+                       np.empty(0))
