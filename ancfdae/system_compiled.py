@@ -8,9 +8,11 @@ number of rigid bodies, with every constraint row in the one compiled set (:attr
   quadratic entries, their slots in ``G``'s pattern, that pattern);
 * ``rigid``: the rigid bodies' coordinates, mass entries, gravity, timed forces and timed moment matrices
   (:meth:`ancfdae.bodies.rigid.RigidBody.residual_parts`) on the system's coordinates;
-* ``beam``: the beam's offset, size and fused-kernel arrays (:func:`ancfdae.models.beam.compiled.compiled_residual`);
+* ``beam``: the beam's offset, size, fused-kernel arrays, its mass in the tangent's pattern and without stored
+  zeros (:func:`ancfdae.models.beam.compiled.compiled_residual`);
 * ``kkt``: the band order of the KKT matrix ``[[K + s M + H, G^T], [G, 0]]`` (its pattern from the arrays above):
-  ``(pos, kl, ku)``, unknown ``i`` at ``pos[i]``, ``kl``/``ku`` its sub- and super-diagonals in that order.
+  ``(pos, kl, ku, ...)``, unknown ``i`` at ``pos[i]``, ``kl``/``ku`` its sub- and super-diagonals in that order,
+  then each part's entries' positions in the band storage (:mod:`ancfdae.integrators._index3_kkt_numba`).
   The System's order puts the multipliers after every coordinate (B6: 57 sub-diagonals of 62 unknowns); reverse
   Cuthill-McKee of the symmetric pattern puts each next to its coordinates (B6: 8 and 8, B5: 9 and 9 of 39), and
   the compiled loops factorise in band storage: fill and LU of B6's matrix 11 us where the dense LU took ~50 us
@@ -100,9 +102,10 @@ class SystemArrays:
         # the mass in the assembly's own pattern (stored zeros kept): the KKT fill adds the tangent's data
         # and the mass's entry by entry, so both must share one pattern (compiled.arrays holds the mass
         # without its zeros, for products only)
+        # (compiled.arrays' zero-free mass: the residual's product M a, as the Python path's)
         asm = beam._asm
         self.beam = (int(off), int(beam.n_dof), q_fixed, gather, vec_slot, mat_slot, beam._M_data,
-                     asm.indptr, asm.indices)
+                     asm.indptr, asm.indices, *compiled.arrays[4:7])
         self.element_args = compiled.element_args
         self.compiled, self._beam_model = compiled, beam
         # the beam's external force: gravity alone is constant; dead loads need their time functions
@@ -112,20 +115,26 @@ class SystemArrays:
         self.kkt = self._band_order(n, rows.m)
 
     def _band_order(self, n: int, m: int) -> tuple:
-        """``(pos, kl, ku)`` of the KKT matrix's pattern (module docstring): every entry the compiled fill writes."""
+        """``kkt`` of the KKT matrix's pattern (module docstring): the band order of every entry the compiled fill
+        writes, and each part's band positions (:mod:`ancfdae.integrators._index3_kkt_numba`)."""
         ob, nb, indptr, indices = self.beam[0], self.beam[1], self.beam[7], self.beam[8]
         ridx, mi, mj, mv, grav, fvec, fcol, ci, cj = self.rigid[:9]
         qi, qj, qk = self.cons[7:10]
         g_indptr, g_indices = self.cons[13], self.cons[14]
         g_rows = n + np.repeat(np.arange(m), np.diff(g_indptr))
-        rows = np.concatenate((ob + np.repeat(np.arange(nb), np.diff(indptr)), mi, ci, qj, g_rows, g_indices))
-        cols = np.concatenate((ob + indices, mj, cj, qk, g_indices, g_rows))
+        parts = ((ob + np.repeat(np.arange(nb), np.diff(indptr)), ob + indices), (mi, mj), (ci, cj), (qj, qk),
+                 (g_rows, g_indices), (g_indices, g_rows))
+        rows = np.concatenate([r for r, _ in parts]).astype(np.int64)
+        cols = np.concatenate([c for _, c in parts]).astype(np.int64)
         N = n + m
         pattern = sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(N, N))
         pos = np.empty(N, dtype=np.int64)
         pos[reverse_cuthill_mckee(pattern, symmetric_mode=True)] = np.arange(N)
         off = pos[rows] - pos[cols]
-        return pos, int(max(off.max(initial=0), 0)), int(max(-off.min(initial=0), 0))
+        kl, ku = int(max(off.max(initial=0), 0)), int(max(-off.min(initial=0), 0))
+        # A[i, j] at AB[pos[j], kl + ku + pos[i] - pos[j]] of the (N, 2 kl + ku + 1) band storage, flat
+        at = [pos[c] * (2 * kl + ku + 1) + kl + ku + pos[r] - pos[c] for r, c in parts]
+        return (pos, kl, ku, *(np.ascontiguousarray(a, dtype=np.int64) for a in at))
 
     @property
     def load_factor(self) -> float:

@@ -24,6 +24,7 @@ import numpy as np
 
 from ancfdae.integrators import _index3_steps_numba as sn
 from ancfdae.integrators._alpha_index3 import EXTRAPOLATE_TOL
+from ancfdae.integrators._index3_kkt_numba import kkt_solve
 from ancfdae.integrators._linsolve import _Banded
 from ancfdae.integrators._newton import _Factor
 from ancfdae.integrators.driver import GRID_TOL
@@ -52,7 +53,7 @@ class _KKTFactors:
 
     def solve(self, rhs):
         rhs = np.ascontiguousarray(rhs, dtype=float)
-        return sn.kkt_solve(self.ab, self.piv, self.kkt, rhs, np.empty(rhs.size), np.empty(rhs.size))
+        return kkt_solve(self.ab, self.piv, self.kkt, rhs, np.empty(rhs.size), np.empty(rhs.size))
 
 
 class Index3Steps:
@@ -70,9 +71,10 @@ class Index3Steps:
             s.t0, s.h, s.t_bound, s.beta, s.gamma, s.alpha_m, s.alpha_f, o.tol, o.contraction, GRID_TOL,
             s._mscale, o.xtol, arrays.load_factor, s.FLOOR_ROUNDOFF, EXTRAPOLATE_TOL)
         self._fpar = f
-        N, (_, kl, ku) = model.n_dof + model.n_constraints, arrays.kkt
-        self._AB, self._piv = np.zeros((N, 2 * kl + ku + 1)), np.zeros(N, dtype=np.int64)
-        self._ABs, self._pivs = np.zeros_like(self._AB), np.zeros(N, dtype=np.int64)
+        N, kl, ku = model.n_dof + model.n_constraints, arrays.kkt[1], arrays.kkt[2]
+        # the pivots with band_factor's trims of the factors (3 N), read by kkt_solve
+        self._AB, self._piv = np.zeros((N, 2 * kl + ku + 1)), np.zeros(3 * N, dtype=np.int64)
+        self._ABs, self._pivs = np.zeros_like(self._AB), np.zeros(3 * N, dtype=np.int64)
         self._no_band = (np.zeros((1, 1), order="F"), np.zeros(1, dtype=np.int32))   # LAPACK's types
         self._table, self._grid = (0, np.zeros((0, 3, arrays.n_weights)), None), None   # (first step, W, E), grid
 

@@ -7,7 +7,8 @@ offers a fused kernel and any number of rigid bodies, every constraint row folde
 update of ``x = [y, mu]``, the step's states, the beam's fused residual and ``+ M a - lambda f_ext``, the rigid
 bodies' ``M a - f(t, q) - f_g``, ``(g, G^T lam)`` in one pass, the norms and the solver's decisions. A refresh
 assembles the KKT matrix ``[[K + s M + H(lam), sm G^T], [sm G, 0]]`` (the beam's tangent from its fused kernel,
-``H`` and ``G`` on their fixed patterns) in band storage, its unknowns in the band order of
+``H`` and ``G`` on their fixed patterns; :func:`~ancfdae.integrators._index3_kkt_numba.kkt_fill`) in band storage,
+its unknowns in the band order of
 :attr:`ancfdae.system_compiled.SystemArrays.kkt` (reverse Cuthill-McKee of its pattern: B6's 62 unknowns have 8 sub-
 and 8 super-diagonals, 57 in the System's order), and factorises it with partial pivoting inside the band
 (:func:`~ancfdae.integrators._linsolve_numba.band_factor`, LAPACK's ``dgbtf2`` elimination); the round-off floor
@@ -21,18 +22,20 @@ is the Python path's. The entry point::
   reached and those before the last step. On entry ``P[3]`` and ``L[1]`` are those at the start of the
   stepper's last step (read only where ``ipar[HAVE_LAST]``: the extrapolating predictor).
 * ``AB, piv``: the band factors of the KKT matrix in band order (``(n + m, 2 kl + ku + 1)``, the layout of
-  :func:`~ancfdae.integrators._linsolve_numba.band_factor`; written at each refresh, ``ipar[KIND] = OWN``),
+  :func:`~ancfdae.integrators._linsolve_numba.band_factor`, ``piv`` of ``3 (n + m)`` with its trims; written at each
+  refresh, ``ipar[KIND] = OWN``),
   ``ABs, pivs`` their copy at the start of a step that refreshed; ``lub, bpiv``: LAPACK's banded factors of the
   matrix in the System's order that the Python path left (``ipar[KIND] = BAND``, its ``KL``, ``KU``).
 * ``W`` (k, 3, nw): per coming step, the time weights at its end and their first two derivatives (the constraint
   terms' :meth:`~ancfdae.joints.assembled.ConstraintSet.weights`, then the rigid bodies' load factors); ``E``
   (k or 1, nb): the beam's external force at each step's end (one row: constant).
 * ``cons``, ``rigid``, ``beam``, ``kkt``: the arrays of :class:`ancfdae.system_compiled.SystemArrays`
-  (``kkt = (pos, kl, ku)``: unknown ``i`` at row and column ``pos[i]`` of the band-ordered matrix).
+  (``kkt``: the band order and the band positions of the KKT matrix's entries, :mod:`._index3_kkt_numba`).
 
 * ``T_rec``: the coming output times (ascending, those after ``t_stop`` ignored). A step accepted here whose end is one
   of them (to ``GRID_TOL``) is recorded: ``q, v, a`` into row ``out[RECORDED]`` of ``rec_q, rec_v, rec_a`` and the
-  multipliers of :func:`system_multipliers` (the driver's, :func:`ancfdae.constrained.multipliers`) into ``rec_lam``;
+  multipliers of :func:`~._index3_kkt_numba.system_multipliers` (the driver's,
+  :func:`ancfdae.constrained.multipliers`) into ``rec_lam``;
   a step that passes one inside (the driver interpolates) or whose multipliers are not finite (the driver's solve
   raises) stops the call, handed to the driver like the last one.
 
@@ -48,12 +51,14 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ancfdae.integrators._index3_kkt_numba import kkt_fill, kkt_solve, multiplier_work, rigid_residual, \
+    system_multipliers
 from ancfdae.integrators._linsolve_numba import band_factor, band_solve
 from ancfdae._scale import max_abs
-from ancfdae.joints.assembled_numba import _g_force, _rates
+from ancfdae.joints.assembled_numba import _g_force
 from ancfdae._residual_numba import finish_residual
 
-__all__ = ["index3_steps", "system_multipliers", "kkt_solve"]
+__all__ = ["index3_steps"]
 
 # fpar
 T0, H, T, T_BOUND, T_STOP, H_MATRIX, BETA, GAMMA, ALPHA_M, ALPHA_F, TOL, ATOL, FLOOR, CONTRACTION, GRID_TOL, \
@@ -72,62 +77,25 @@ STOPPED, NEEDS_PYTHON = 0, 1
 
 
 @njit(inline="always")
-def _put(AB, kv, pos, i, j, val):
-    """``A[i, j] += val`` of the KKT matrix: row and column ``pos[.]`` of the band order, band storage."""
-    pi, pj = pos[i], pos[j]
-    AB[pj, kv + pi - pj] += val
-
-
-@njit(cache=True, error_model="numpy")   # a zero pivot gives inf/nan, as LAPACK does
-def kkt_solve(AB, piv, kkt, r, d, b):
-    """``d = A^-1 r`` with the band factors ``AB, piv`` of the KKT matrix in band order (``d`` returned, ``b`` a
-    work array, both of ``r``'s size); ``r`` is in the System's order, and so is the result."""
-    pos, kl, ku = kkt
-    for i in range(r.size):
-        b[pos[i]] = r[i]
-    band_solve(AB.T, kl, ku, piv, b)
-    for i in range(r.size):
-        d[i] = b[pos[i]]
-    return d
-
-
-@njit(cache=True)
-def _rigid_residual(r, q, a, w, rigid, f, ma):
-    """``r_i = (M a)_i - f_i(t, q) - f_g,i`` on the rigid bodies' coordinates (``RigidBody.residual``); ``f``,
-    ``ma``: work arrays of ``r``'s size."""
-    ridx, mi, mj, mv, grav, fvec, fcol, ci, cj, cv, ccol = rigid
-    f[:] = 0.0
-    ma[:] = 0.0
-    for k in range(fcol.size):
-        s = w[fcol[k]]
-        for i in ridx:
-            f[i] += s * fvec[k, i]
-    for e in range(ci.size):
-        f[ci[e]] += w[ccol[e]] * cv[e] * q[cj[e]]
-    for e in range(mi.size):
-        ma[mi[e]] += mv[e] * a[mj[e]]
-    for i in ridx:
-        r[i] = (ma[i] - f[i]) - grav[i]
-
-
-@njit(inline="always")
-def _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid, beam, eargs, rbuf, kbuf, work):
+def _residual(fused, x, r, n, m, qp, ca, s, sm, w, ext, lf, cons, rigid, beam, eargs, rbuf, kbuf, work):
     """The step's residual ``[r(t1, q1, v1, a1) + G^T lam; sm g]`` at ``x`` into ``r``; returns ``(max|r|, q1)``
-    (``q1`` in the work arrays ``work = (q, v, a, lam, g, f, f2, ma)``, overwritten by the next call)."""
-    ob, nb, q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices = beam
+    (``q1`` in the work arrays ``work = (q, v, a, lam, g, f, f2, ma)``, overwritten by the next call; ``rbuf`` the
+    beam's force at ``q1``). ``v1`` is not formed: neither the fused beam kernels nor the rigid bodies depend on it
+    (no damping)."""
+    ob, nb, q_fixed, gather, vec_slot, mat_slot = beam[:6]
+    mr_data, mr_indptr, mr_indices = beam[9:12]   # the mass without its stored zeros, as the Python path's
     q, v, a, lam, g, f, f2, ma = work
     for i in range(n):
         y = x[i]
         q[i] = qp[i] + y
-        v[i] = vp[i] + c_v * y
         a[i] = s * y + ca[i]
     for i in range(m):
         lam[i] = sm * x[n + i]
     fused(q[ob:ob + nb], q_fixed, gather, vec_slot, mat_slot, False, rbuf, kbuf, *eargs)
-    finish_residual(rbuf, m_data, indptr, indices, a[ob:ob + nb], lf, ext)
-    _rigid_residual(r, q, a, w, rigid, f2, ma)
-    for i in range(nb):
+    for i in range(nb):   # rbuf keeps the beam's force: the reactions at an output time reuse it
         r[ob + i] = rbuf[i]
+    finish_residual(r[ob:ob + nb], mr_data, mr_indptr, mr_indices, a[ob:ob + nb], lf, ext)
+    rigid_residual(r, q, a, w, rigid, f2, ma)
     lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa = cons[:11]
     _g_force(w, lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa, q, lam, g, f)
     for i in range(n):
@@ -135,48 +103,6 @@ def _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid
     for i in range(m):
         r[n + i] = sm * g[i]
     return max_abs(r), q
-
-
-@njit(inline="always")
-def _matrix(fused, AB, x, q, n, m, s, sm, w, cons, rigid, beam, eargs, rbuf, kbuf, kkt):
-    """The KKT matrix at ``x`` (state ``q``) into ``AB`` (band order and storage, ``kkt``); returns
-    ``(max|K|, max|sm G|)``."""
-    ob, nb, q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices = beam
-    lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa, ls, qslot, g_indptr, g_indices = cons
-    ridx, mi, mj, mv, grav, fvec, fcol, ci, cj, cvv, ccol = rigid
-    pos, kl, ku = kkt
-    kv = kl + ku
-    AB[:, :] = 0.0
-    fused(q[ob:ob + nb], q_fixed, gather, vec_slot, mat_slot, True, rbuf, kbuf, *eargs)
-    kmax = 0.0
-    for i in range(nb):
-        for jj in range(indptr[i], indptr[i + 1]):
-            _put(AB, kv, pos, ob + i, ob + indices[jj], kbuf[jj] + s * m_data[jj])
-            kmax = max(kmax, abs(kbuf[jj]))
-    for e in range(mi.size):
-        _put(AB, kv, pos, mi[e], mj[e], s * mv[e])
-    for e in range(ci.size):
-        k = -(w[ccol[e]] * cvv[e])
-        _put(AB, kv, pos, ci[e], cj[e], k)
-        kmax = max(kmax, abs(k))
-    lam = np.empty(m)
-    for i in range(m):
-        lam[i] = sm * x[n + i]
-    for e in range(qi.size):   # H(lam) = sum_i lam_i A_i
-        _put(AB, kv, pos, qj[e], qk[e], qa[e] * lam[qi[e]])
-    gdata = np.zeros(g_indices.size)
-    for e in range(lt.size):
-        gdata[ls[e]] += w[lt[e]] * lv[e]
-    for e in range(qi.size):
-        gdata[qslot[e]] += qa[e] * q[qk[e]]
-    gmax = 0.0
-    for i in range(m):
-        for jj in range(g_indptr[i], g_indptr[i + 1]):
-            val = sm * gdata[jj]
-            _put(AB, kv, pos, n + i, g_indices[jj], val)
-            _put(AB, kv, pos, g_indices[jj], n + i, val)
-            gmax = max(gmax, abs(val))
-    return kmax, gmax
 
 
 @njit(inline="always")
@@ -200,7 +126,8 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv,
     work = (np.empty(n), np.empty(n), np.empty(n), np.empty(m), np.empty(m), np.empty(n), np.empty(n), np.empty(n))
     t = fpar[T]
     done, iters, evals, jacs, status, nrec = 0, 0, 0, 0, NEEDS_PYTHON, 0
-    a_scratch = np.empty(n)
+    a_scratch, lam_w, gdata = np.empty(n), np.empty(m), np.empty(cons[14].size)
+    mwork = multiplier_work(n, m, nb, AB.shape[1], cons[14].size)
     eps = np.finfo(np.float64).eps
     while done < max_count:
         t_new = t0 + (n_steps + done + 1) * h
@@ -230,7 +157,7 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv,
         for i in range(m):
             x[n + i] = (2.0 * L[0, i] - L[1, i]) / sm if extra else L[0, i] / sm
         # NewtonSolver.solve and _attempt (modified Newton)
-        err, q = _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid, beam, eargs,
+        err, q = _residual(fused, x, r, n, m, qp, ca, s, sm, w, ext, lf, cons, rigid, beam, eargs,
                            rbuf, kbuf, work)
         its, ev, jc, saved = 0, 1, 0, False
         ok = np.isfinite(err)
@@ -246,7 +173,8 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv,
                         ABs[:, :] = AB
                         pivs[:] = piv
                         saved = True
-                    kmax, gmax = _matrix(fused, AB, x, q, n, m, s, sm, w, cons, rigid, beam, eargs, rbuf, kbuf, kkt)
+                    kmax, gmax = kkt_fill(fused, AB, x, q, n, m, s, sm, w, cons, rigid, beam, eargs, rbuf, kbuf, kkt,
+                                          lam_w, gdata)
                     qm = max(1.0, max_abs(q))
                     floor = max(floor, max(ffac * eps * kmax * qm, ffac * eps * gmax * qm))
                     band_factor(AB, kkt[1], kkt[2], piv)
@@ -264,7 +192,7 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv,
                     break
                 for i in range(N):
                     x[i] = x[i] - dx[i]
-                err_new, q = _residual(fused, x, r, n, m, qp, vp, ca, c_v, s, sm, w, ext, lf, cons, rigid, beam,
+                err_new, q = _residual(fused, x, r, n, m, qp, ca, s, sm, w, ext, lf, cons, rigid, beam,
                                        eargs, rbuf, kbuf, work)
                 ev += 1
                 if not np.isfinite(err_new):
@@ -325,8 +253,9 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv,
             if abs(T_rec[nrec] - t) > tol_t:   # inside the step: the driver interpolates
                 status = STOPPED
                 break
+            # the last residual was at the accepted state: rbuf holds the beam's force at S[0]
             system_multipliers(fused, W[wi], ext, S[0], S[1], a_scratch, rec_lam[nrec], cons, rigid, beam, eargs, lf,
-                               kkt)
+                               kkt, mwork, rbuf)
             if not np.isfinite(max_abs(rec_lam[nrec])):   # the driver's solve reports it
                 status = STOPPED
                 break
@@ -339,53 +268,3 @@ def index3_steps(fused, S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv,
     ipar[KIND], ipar[HAVE_H] = kind, have_h
     out[DONE], out[STATUS], out[ITERATIONS], out[RESIDUALS], out[JACOBIANS], out[RECORDED] = (done, status, iters,
                                                                                            evals, jacs, nrec)
-
-
-@njit(inline="always")
-def system_multipliers(fused, W, ext, q, v, a_out, lam_out, cons, rigid, beam, eargs, lf, kkt):
-    """``(a, lam)`` from ``[[M, G^T], [G, 0]] [a; lam] = [-r(t, q, v, 0); gamma]`` (:func:`ancfdae.constrained.multipliers`)
-    into ``a_out``, ``lam_out``: ``W`` (3, nw) the time weights at ``t`` and their derivatives, ``ext`` the beam's
-    external force at ``t``, ``lf`` its load factor; the matrix in the band order ``kkt`` (its pattern is in the
-    steps' KKT pattern); a singular matrix gives non-finite values."""
-    n, m = q.size, lam_out.size
-    N = n + m
-    ob, nb, q_fixed, gather, vec_slot, mat_slot, m_data, indptr, indices = beam
-    lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa, ls, qslot, g_indptr, g_indices = cons
-    ridx, mi, mj, mv, grav, fvec, fcol, ci, cj, cvv, ccol = rigid
-    zero, r = np.zeros(n), np.zeros(n)
-    rbuf, kbuf = np.empty(nb + 1), np.empty(1)
-    fused(q[ob:ob + nb], q_fixed, gather, vec_slot, mat_slot, False, rbuf, kbuf, *eargs)
-    finish_residual(rbuf, m_data, indptr, indices, zero[ob:ob + nb], lf, ext)
-    _rigid_residual(r, q, zero, W[0], rigid, np.empty(n), np.empty(n))
-    for i in range(nb):
-        r[ob + i] = rbuf[i]
-    gt, gamma = np.empty(m), np.empty(m)
-    _rates(W[1], W[2], lt, lr, lc, lv, ct, cr, cv, qi, qj, qk, qa, q, v, gt, gamma)
-    pos, kl, ku = kkt
-    kv = kl + ku
-    AB, rhs = np.zeros((N, 2 * kl + ku + 1)), np.empty(N)
-    for i in range(nb):
-        for jj in range(indptr[i], indptr[i + 1]):
-            _put(AB, kv, pos, ob + i, ob + indices[jj], m_data[jj])
-    for e in range(mi.size):
-        _put(AB, kv, pos, mi[e], mj[e], mv[e])
-    gdata = np.zeros(g_indices.size)
-    for e in range(lt.size):
-        gdata[ls[e]] += W[0, lt[e]] * lv[e]
-    for e in range(qi.size):
-        gdata[qslot[e]] += qa[e] * q[qk[e]]
-    for i in range(m):
-        for jj in range(g_indptr[i], g_indptr[i + 1]):
-            _put(AB, kv, pos, n + i, g_indices[jj], gdata[jj])
-            _put(AB, kv, pos, g_indices[jj], n + i, gdata[jj])
-    for i in range(n):
-        rhs[i] = -r[i]
-    for i in range(m):
-        rhs[n + i] = gamma[i]
-    piv = np.empty(N, dtype=np.int64)
-    band_factor(AB, kl, ku, piv)
-    x = kkt_solve(AB, piv, kkt, rhs, np.empty(N), np.empty(N))
-    for i in range(n):
-        a_out[i] = x[i]
-    for i in range(m):
-        lam_out[i] = x[n + i]

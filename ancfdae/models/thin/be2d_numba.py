@@ -19,7 +19,8 @@ from ...integrators._affine import affine3
 from ..beam.iteration_numba import alpha_finish, alpha_update, carry_on
 from ...integrators._alpha_steps_numba import alpha_steps
 from ..beam.static_numba import static_newton
-from ...integrators._index3_steps_numba import index3_steps, system_multipliers
+from ...integrators._index3_steps_numba import index3_steps
+from ...integrators._index3_kkt_numba import multiplier_work, system_multipliers
 from .be2d_energy_numba import CONTINUUM, STRUCTURAL
 
 __all__ = ["be2d_forces", "be2d_fused", "be2d_alpha_iterations", "be2d_alpha_steps",
@@ -265,5 +266,7 @@ def be2d_index3_steps(S, P, L, fpar, ipar, out, AB, piv, ABs, pivs, lub, bpiv, W
 
 @njit(cache=True)
 def be2d_multipliers(W, ext, q, v, a, lam, cons, rigid, beam, element_args, load_factor, kkt):
-    """A System's ``(a, lam)`` at an output time in one call (:func:`ancfdae.integrators._index3_steps_numba.system_multipliers`)."""
-    system_multipliers(be2d_fused, W, ext, q, v, a, lam, cons, rigid, beam, element_args, load_factor, kkt)
+    """A System's ``(a, lam)`` at an output time in one call (:func:`ancfdae.integrators._index3_kkt_numba.system_multipliers`)."""
+    work = multiplier_work(q.size, lam.size, beam[1], 2 * kkt[1] + kkt[2] + 1, cons[14].size)
+    system_multipliers(be2d_fused, W, ext, q, v, a, lam, cons, rigid, beam, element_args, load_factor, kkt, work,
+                       np.empty(0))
