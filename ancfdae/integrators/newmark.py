@@ -311,10 +311,7 @@ class HHTAlpha(_AlphaFamily):
     newton : NewtonOptions or dict, optional
         Newton options (default: modified Newton, tolerance 1e-8).
     predictor : {"auto", "extrapolate", "constant"}
-        Newton's start on a constrained model (index 3): "auto" (default) and "extrapolate" take ``ah`` and the
-        multipliers extrapolated linearly from the last two steps of equal size, "constant" the current ones
-        (:func:`ancfdae.integrators._alpha_index3.predictor`). An unconstrained model's steps start from ``a_n``
-        ("auto", "constant"; "extrapolate" raises).
+        Newton's start on a constrained model, as for :class:`Newmark`.
     """
 
     name = "hht"
@@ -353,10 +350,7 @@ class GeneralizedAlpha(_AlphaFamily):
     newton : NewtonOptions or dict, optional
         Newton options (default: modified Newton, tolerance 1e-8).
     predictor : {"auto", "extrapolate", "constant"}
-        Newton's start on a constrained model (index 3): "auto" (default) and "extrapolate" take ``ah`` and the
-        multipliers extrapolated linearly from the last two steps of equal size, "constant" the current ones
-        (:func:`ancfdae.integrators._alpha_index3.predictor`). An unconstrained model's steps start from ``a_n``
-        ("auto", "constant"; "extrapolate" raises).
+        Newton's start on a constrained model, as for :class:`Newmark`.
     """
 
     name = "generalized-alpha"
